@@ -1,0 +1,16 @@
+#pragma once
+// The subcommands of `mcopt`; each registers its options on the CLI11 app and returns
+// the function that runs it (exit code).
+
+#include <CLI/CLI.hpp>
+#include <functional>
+
+namespace mcopt::cli {
+
+using Runner = std::function<int()>;
+
+Runner addRobotInfo(CLI::App& robot);
+Runner addDynamics(CLI::App& app);
+Runner addEvaluate(CLI::App& app);
+
+}  // namespace mcopt::cli

@@ -1,0 +1,121 @@
+// `mcopt dynamics`: inverse dynamics of given states with the reference body held
+// fixed (formulation.md §4). Formats: docs/file-formats.md.
+#include <iostream>
+
+#include "apps/commands.hpp"
+#include "apps/json_io.hpp"
+#include "core/atomic_file.hpp"
+#include "core/inverse_dynamics.hpp"
+
+namespace mcopt::cli {
+
+namespace {
+
+struct DynamicsOptions {
+  std::string robot, referenceBody, states, out;
+  bool allowNonPhysicalInertia = false;
+};
+
+RigidTransform readPose(const std::filesystem::path& file, const json_io::Json& node, const std::string& field) {
+  RigidTransform pose;
+  if (!node.is_object()) throw InputError(file.string() + ": " + field + ": expected an object");
+  for (const auto& [key, value] : node.items())
+    if (key != "position" && key != "quaternion_xyzw")
+      throw InputError(file.string() + ": " + field + "." + key + ": unknown key (expected position, quaternion_xyzw)");
+  if (node.contains("position")) pose.translation = json_io::numbers(file, node["position"], field + ".position", 3);
+  if (node.contains("quaternion_xyzw")) {
+    const Eigen::VectorXd q = json_io::numbers(file, node["quaternion_xyzw"], field + ".quaternion_xyzw", 4);
+    if (q.norm() < 1e-9) throw InputError(file.string() + ": " + field + ".quaternion_xyzw: zero quaternion");
+    pose.rotation = rotationFromQuaternionXyzw(q[0], q[1], q[2], q[3]);
+  }
+  return pose;
+}
+
+int runDynamics(const DynamicsOptions& o) {
+  const RobotModel robot = loadUrdfFile(o.robot, {o.allowNonPhysicalInertia});
+  for (const std::string& w : robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
+  const std::filesystem::path file = o.states;
+  const json_io::Json input = json_io::readFile(file);
+  if (!input.is_object()) throw InputError(file.string() + ": expected a JSON object");
+  for (const auto& [key, value] : input.items())
+    if (key != "joint_names" && key != "gravity" && key != "reference_pose" && key != "states")
+      throw InputError(file.string() + ": " + key + ": unknown key (expected joint_names, gravity, reference_pose, states)");
+
+  std::vector<int> columns;  // input position → URDF joint index
+  std::vector<std::string> names;
+  if (input.contains("joint_names")) {
+    if (!input["joint_names"].is_array()) throw InputError(file.string() + ": joint_names: expected a list of names");
+    std::vector<bool> seen(static_cast<std::size_t>(robot.jointCount()), false);
+    for (std::size_t k = 0; k < input["joint_names"].size(); ++k) {
+      const auto& name = input["joint_names"][k];
+      const std::string field = "joint_names[" + std::to_string(k) + "]";
+      if (!name.is_string()) throw InputError(file.string() + ": " + field + ": expected a joint name");
+      const int j = robot.findJoint(name);
+      if (j < 0) throw InputError(file.string() + ": " + field + ": unknown joint '" + name.get<std::string>() + "'");
+      if (seen[static_cast<std::size_t>(j)])
+        throw InputError(file.string() + ": " + field + ": joint '" + name.get<std::string>() + "' listed twice");
+      seen[static_cast<std::size_t>(j)] = true;
+      columns.push_back(j);
+      names.push_back(name);
+    }
+  } else {
+    for (int j = 0; j < robot.jointCount(); ++j) columns.push_back(j);
+    names = robot.jointNames();
+  }
+  const Vector3 gravity =
+      input.contains("gravity") ? Vector3(json_io::numbers(file, input["gravity"], "gravity", 3)) : Vector3(0, 0, -9.81);
+  const RigidTransform referencePose =
+      input.contains("reference_pose") ? readPose(file, input["reference_pose"], "reference_pose") : RigidTransform{};
+  const std::string referenceBody = o.referenceBody.empty() ? robot.frames[0].name : o.referenceBody;
+  const DynamicsModel model(robot, referenceBody, referencePose, gravity);
+  DynamicsData data(model);
+
+  if (!input.contains("states") || !input["states"].is_array())
+    throw InputError(file.string() + ": states: expected a list of {q, v, a}");
+  const long count = static_cast<long>(columns.size());
+  json_io::Json results = json_io::Json::array();
+  Eigen::VectorXd q(robot.jointCount()), v(robot.jointCount()), a(robot.jointCount()), tau(count);
+  for (std::size_t s = 0; s < input["states"].size(); ++s) {
+    const auto& state = input["states"][s];
+    const std::string field = "states[" + std::to_string(s) + "]";
+    if (!state.is_object()) throw InputError(file.string() + ": " + field + ": expected an object {q, v, a}");
+    q.setZero();
+    v.setZero();
+    a.setZero();
+    for (const char* key : {"q", "v", "a"}) {
+      if (!state.contains(key)) continue;  // absent: zero
+      const Eigen::VectorXd values = json_io::numbers(file, state[key], field + "." + key, count);
+      Eigen::VectorXd& target = key[0] == 'q' ? q : key[0] == 'v' ? v : a;
+      for (long k = 0; k < count; ++k) target[columns[static_cast<std::size_t>(k)]] = values[k];
+    }
+    inverseDynamics(model, data, q, v, a);
+    for (long k = 0; k < count; ++k) tau[k] = data.tau[columns[static_cast<std::size_t>(k)]];
+    results.push_back({{"tau", json_io::toJson(tau)},
+                       {"reference_wrench", json_io::toJson(referenceWrenchAtReferenceFrame(model, data))}});
+  }
+  json_io::Json out;
+  out["joint_names"] = names;
+  out["results"] = results;
+  const std::string text = out.dump(1) + "\n";
+  if (o.out.empty())
+    std::cout << text;
+  else
+    writeFileAtomically(o.out, text);
+  return 0;
+}
+
+}  // namespace
+
+Runner addDynamics(CLI::App& command) {
+  auto o = std::make_shared<DynamicsOptions>();
+  command.add_option("--robot", o->robot, "URDF file")->required()->check(CLI::ExistingFile);
+  command.add_option("--reference-body", o->referenceBody,
+                     "link held fixed at reference_pose (default: the URDF root); any link, sole frames included");
+  command.add_option("--states", o->states, "input JSON (docs/file-formats.md)")->required();
+  command.add_option("--out", o->out, "output JSON (default: standard output)");
+  command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,
+                   "load inertias that break positivity or the triangle inequality, with a warning");
+  return [o] { return runDynamics(*o); };
+}
+
+}  // namespace mcopt::cli

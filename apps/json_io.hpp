@@ -1,0 +1,61 @@
+#pragma once
+// JSON reading for the command's input files: every error names the file and the field.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/errors.hpp"
+
+namespace mcopt::json_io {
+
+using Json = nlohmann::json;
+
+inline Json readFile(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path.string() + ": cannot open (missing or unreadable)");
+  try {
+    return Json::parse(in);
+  } catch (const Json::parse_error& e) {
+    throw InputError(path.string() + ": malformed JSON: " + e.what());
+  }
+}
+
+/// A list of `count` finite numbers (count < 0: any length).
+inline Eigen::VectorXd numbers(const std::filesystem::path& file, const Json& node, const std::string& field,
+                               long count = -1) {
+  if (!node.is_array() || (count >= 0 && static_cast<long>(node.size()) != count))
+    throw InputError(file.string() + ": " + field + ": expected a list of " +
+                     (count >= 0 ? std::to_string(count) + " " : "") + "numbers" +
+                     (node.is_array() ? ", got " + std::to_string(node.size()) : ""));
+  Eigen::VectorXd v(static_cast<Eigen::Index>(node.size()));
+  for (std::size_t i = 0; i < node.size(); ++i) {
+    if (!node[i].is_number())
+      throw InputError(file.string() + ": " + field + "[" + std::to_string(i) + "]: expected a number");
+    v[static_cast<Eigen::Index>(i)] = node[i].get<double>();
+    if (!std::isfinite(v[static_cast<Eigen::Index>(i)]))
+      throw InputError(file.string() + ": " + field + "[" + std::to_string(i) + "]: not a finite number");
+  }
+  return v;
+}
+
+inline Json toJson(const Eigen::Ref<const Eigen::VectorXd>& v) {
+  Json a = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+/// Row-major nested arrays.
+inline Json matrixToJson(const Eigen::Ref<const Eigen::MatrixXd>& m) {
+  Json rows = Json::array();
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    Json row = Json::array();
+    for (Eigen::Index c = 0; c < m.cols(); ++c) row.push_back(m(r, c));
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace mcopt::json_io

@@ -1,0 +1,36 @@
+// mcopt: whole-body motion optimisation for humanoid robots in multi-contact.
+#include <iostream>
+
+#include "apps/commands.hpp"
+#include "core/errors.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"mcopt — whole-body motion optimisation for humanoid robots in multi-contact"};
+  app.require_subcommand(1);
+  CLI::App* robot = app.add_subcommand("robot", "inspect a robot description");
+  robot->require_subcommand(1);
+  mcopt::cli::Runner run;
+  std::vector<std::pair<CLI::App*, mcopt::cli::Runner>> runners;
+  CLI::App* info = robot->add_subcommand("info", "bodies, actuated joints, mass and centre of mass");
+  runners.emplace_back(info, mcopt::cli::addRobotInfo(*info));
+  CLI::App* dynamics = app.add_subcommand("dynamics", "inverse dynamics of given states at a fixed reference body");
+  runners.emplace_back(dynamics, mcopt::cli::addDynamics(*dynamics));
+  CLI::App* evaluate = app.add_subcommand("evaluate", "torques, reference wrench and energy of a spline motion");
+  runners.emplace_back(evaluate, mcopt::cli::addEvaluate(*evaluate));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    for (auto& [command, runner] : runners)
+      if (command->parsed()) return runner();
+  } catch (const mcopt::InputError& e) {
+    std::cerr << "mcopt: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "mcopt: internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 1;
+}

@@ -1,0 +1,103 @@
+// `mcopt robot info`: what a robot description contains, in text or JSON.
+#include <iomanip>
+#include <iostream>
+
+#include "apps/commands.hpp"
+#include "apps/json_io.hpp"
+#include "core/actuators.hpp"
+#include "core/inverse_dynamics.hpp"
+#include "core/kinematics.hpp"
+
+namespace mcopt::cli {
+
+namespace {
+
+struct RobotInfoOptions {
+  std::string robot, actuators;
+  bool json = false, allowNonPhysicalInertia = false;
+};
+
+json_io::Json finiteOrNull(double value) { return std::isfinite(value) ? json_io::Json(value) : json_io::Json(); }
+
+const char* typeName(JointType type) {
+  switch (type) {
+    case JointType::Revolute: return "revolute";
+    case JointType::Continuous: return "continuous";
+    case JointType::Prismatic: return "prismatic";
+  }
+  return "?";
+}
+
+int runRobotInfo(const RobotInfoOptions& o) {
+  const RobotModel robot = loadUrdfFile(o.robot, {o.allowNonPhysicalInertia});
+  for (const std::string& w : robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
+  const ActuatorSet actuators = o.actuators.empty() ? defaultActuators(robot) : loadActuators(o.actuators, robot);
+  const DynamicsModel model(robot, robot.frames[0].name);
+  DynamicsData data(model);
+  forwardKinematics(model, data, Eigen::VectorXd::Zero(robot.jointCount()));
+  const Vector3 com = centerOfMass(model, data);
+
+  // Limits: actuator file over URDF (formulation.md §2).
+  auto effort = [&](int j) { return actuators.joints[j].torqueLimit; };
+  auto velocity = [&](int j) { return actuators.joints[j].velocityLimit; };
+
+  if (o.json) {
+    json_io::Json out;
+    out["name"] = robot.name;
+    out["source"] = robot.source;
+    out["total_mass"] = robot.totalMass();
+    out["com"] = json_io::toJson(Eigen::VectorXd(com));
+    out["root"] = robot.frames[0].name;
+    out["joints"] = json_io::Json::array();
+    for (int j = 0; j < robot.jointCount(); ++j) {
+      const Joint& joint = robot.joints[j];
+      const ActuatorParameters& a = actuators.joints[j];
+      out["joints"].push_back({{"name", joint.name},
+                               {"type", typeName(joint.type)},
+                               {"parent", robot.bodies[joint.parentBody].name},
+                               {"child", robot.bodies[joint.childBody].name},
+                               {"lower", finiteOrNull(joint.limits.lower)},
+                               {"upper", finiteOrNull(joint.limits.upper)},
+                               {"velocity", finiteOrNull(velocity(j))},
+                               {"effort", finiteOrNull(effort(j))},
+                               {"gear_ratio", a.gearRatio},
+                               {"torque_constant", a.torqueConstant},
+                               {"resistance", a.resistance}});
+    }
+    out["bodies"] = json_io::Json::array();
+    for (const Body& body : robot.bodies)
+      out["bodies"].push_back({{"name", body.name}, {"mass", body.inertia.mass}});
+    out["frames"] = json_io::Json::array();
+    for (const Frame& frame : robot.frames) out["frames"].push_back(frame.name);
+    out["warnings"] = robot.warnings;
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "robot " << robot.name << " (" << robot.source << ")\n"
+            << "  " << robot.bodyCount() << " bodies (fixed joints merged), " << robot.frames.size()
+            << " frames, " << robot.jointCount() << " actuated joints\n"
+            << std::fixed << std::setprecision(3) << "  total mass " << robot.totalMass() << " kg, centre of mass at"
+            << " the zero posture (root frame) [" << com.transpose() << "] m\n\n"
+            << "  #   joint                       lower     upper    vel.max  effort.max\n";
+  for (int j = 0; j < robot.jointCount(); ++j) {
+    const Joint& joint = robot.joints[j];
+    std::cout << "  " << std::setw(3) << std::left << j << " " << std::setw(24) << joint.name << std::right
+              << std::setw(10) << joint.limits.lower << std::setw(10) << joint.limits.upper << std::setw(10)
+              << velocity(j) << std::setw(11) << effort(j) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Runner addRobotInfo(CLI::App& command) {
+  auto o = std::make_shared<RobotInfoOptions>();
+  command.add_option("--robot", o->robot, "URDF file")->required()->check(CLI::ExistingFile);
+  command.add_option("--actuators", o->actuators, "actuator YAML file (formulation.md §2)")->check(CLI::ExistingFile);
+  command.add_flag("--json", o->json, "print JSON instead of text");
+  command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,
+                   "load inertias that break positivity or the triangle inequality, with a warning");
+  return [o] { return runRobotInfo(*o); };
+}
+
+}  // namespace mcopt::cli

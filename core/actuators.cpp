@@ -1,0 +1,84 @@
+#include "core/actuators.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "core/yaml_fields.hpp"
+
+namespace mcopt {
+
+ActuatorSet defaultActuators(const RobotModel& robot) {
+  ActuatorSet set;
+  set.joints.resize(robot.joints.size());
+  for (std::size_t j = 0; j < robot.joints.size(); ++j) {
+    const Joint& joint = robot.joints[j];
+    ActuatorParameters& a = set.joints[j];
+    a.torqueLimit = joint.limits.effort;
+    a.velocityLimit = joint.limits.velocity;
+    a.viscousFriction = joint.damping;
+    a.dryFriction = joint.friction;
+  }
+  return set;
+}
+
+namespace {
+
+void readJoint(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
+               ActuatorParameters& a) {
+  yaml::rejectUnknownKeys(file, node, field,
+                          {"gear_ratio", "torque_constant", "resistance", "rotor_inertia", "viscous_friction",
+                           "dry_friction", "torque_limit", "velocity_limit"});
+  if (node["gear_ratio"]) a.gearRatio = yaml::positive(file, node["gear_ratio"], field + ".gear_ratio");
+  if (node["torque_constant"])
+    a.torqueConstant = yaml::positive(file, node["torque_constant"], field + ".torque_constant");
+  if (node["resistance"]) a.resistance = yaml::nonNegative(file, node["resistance"], field + ".resistance");
+  if (node["rotor_inertia"]) a.rotorInertia = yaml::nonNegative(file, node["rotor_inertia"], field + ".rotor_inertia");
+  if (node["viscous_friction"])
+    a.viscousFriction = yaml::nonNegative(file, node["viscous_friction"], field + ".viscous_friction");
+  if (node["dry_friction"]) a.dryFriction = yaml::nonNegative(file, node["dry_friction"], field + ".dry_friction");
+  if (node["torque_limit"]) a.torqueLimit = yaml::positive(file, node["torque_limit"], field + ".torque_limit");
+  if (node["velocity_limit"])
+    a.velocityLimit = yaml::positive(file, node["velocity_limit"], field + ".velocity_limit");
+}
+
+}  // namespace
+
+ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& robot) {
+  const YAML::Node root = yaml::loadFile(path);
+  yaml::rejectUnknownKeys(path, root, "", {"friction_sharpness", "defaults", "joints", "sources"});
+  ActuatorSet set = defaultActuators(robot);
+  if (root["friction_sharpness"])
+    set.frictionSharpness = yaml::positive(path, root["friction_sharpness"], "friction_sharpness");
+  if (root["defaults"])
+    for (ActuatorParameters& a : set.joints) readJoint(path, root["defaults"], "defaults", a);
+  const YAML::Node joints = yaml::required(path, root, "joints", "");
+  if (!joints.IsMap()) throw InputError(yaml::where(path, joints, "joints") + "expected a mapping joint name → values");
+  for (const auto& entry : joints) {
+    const std::string name = entry.first.as<std::string>();
+    const int index = robot.findJoint(name);
+    if (index < 0)
+      throw InputError(yaml::where(path, entry.first, "joints." + name) + "unknown joint (not an actuated joint of " +
+                       robot.source + ")");
+    readJoint(path, entry.second, "joints." + name, set.joints[index]);
+  }
+  return set;
+}
+
+double frictionTorque(const ActuatorParameters& actuator, double motorSpeed, double sharpness) {
+  return actuator.viscousFriction * motorSpeed +
+         actuator.dryFriction * (2.0 / std::numbers::pi) * std::atan(sharpness * motorSpeed);
+}
+
+MotorPower motorPower(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
+                      double acceleration) {
+  const double n = actuator.gearRatio;
+  const double motorSpeed = n * velocity;
+  MotorPower out;
+  out.motorTorque =
+      torque / n + actuator.rotorInertia * n * acceleration + frictionTorque(actuator, motorSpeed, sharpness);
+  const double k = actuator.torqueConstant;
+  out.power = out.motorTorque * motorSpeed + (actuator.resistance / (k * k)) * out.motorTorque * out.motorTorque;
+  return out;
+}
+
+}  // namespace mcopt

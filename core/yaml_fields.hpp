@@ -1,0 +1,95 @@
+#pragma once
+// Reading YAML with messages that name the file, the line and the field (yaml-cpp marks).
+// Private to the loaders' .cpp files.
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <initializer_list>
+#include <string>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace mcopt::yaml {
+
+/// "file:line: field: " for a node.
+inline std::string where(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  const int line = node.Mark().line >= 0 ? node.Mark().line + 1 : 0;
+  return file.string() + ":" + std::to_string(line) + ": " + field + ": ";
+}
+
+inline YAML::Node loadFile(const std::filesystem::path& file) {
+  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": file not found");
+  try {
+    return YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
+  }
+}
+
+inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Node& map, const std::string& field,
+                              std::initializer_list<const char*> allowed) {
+  if (!map.IsMap()) throw InputError(where(file, map, field) + "expected a mapping");
+  for (const auto& entry : map) {
+    const std::string key = entry.first.as<std::string>();
+    bool known = false;
+    std::string list;
+    for (const char* name : allowed) {
+      known = known || key == name;
+      list += std::string(list.empty() ? "" : ", ") + name;
+    }
+    if (!known)
+      throw InputError(where(file, entry.first, field.empty() ? key : field + "." + key) + "unknown key (expected one of " +
+                       list + ")");
+  }
+}
+
+inline double number(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  double value = 0.0;
+  try {
+    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
+    value = node.as<double>();
+  } catch (const YAML::Exception&) {
+    throw InputError(where(file, node, field) + "expected a number");
+  }
+  if (!std::isfinite(value)) throw InputError(where(file, node, field) + "must be finite, got " + node.as<std::string>());
+  return value;
+}
+
+inline double positive(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  const double value = number(file, node, field);
+  if (value <= 0.0) throw InputError(where(file, node, field) + "must be positive, got " + std::to_string(value));
+  return value;
+}
+
+inline double nonNegative(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  const double value = number(file, node, field);
+  if (value < 0.0) throw InputError(where(file, node, field) + "must not be negative, got " + std::to_string(value));
+  return value;
+}
+
+inline std::vector<double> numbers(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
+                                   std::size_t count) {
+  if (!node.IsSequence() || node.size() != count)
+    throw InputError(where(file, node, field) + "expected a list of " + std::to_string(count) + " numbers");
+  std::vector<double> values;
+  for (std::size_t i = 0; i < count; ++i)
+    values.push_back(number(file, node[i], field + "[" + std::to_string(i) + "]"));
+  return values;
+}
+
+inline std::string text(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  if (!node.IsScalar()) throw InputError(where(file, node, field) + "expected a string");
+  return node.as<std::string>();
+}
+
+inline const YAML::Node required(const std::filesystem::path& file, const YAML::Node& map, const char* key,
+                                 const std::string& field) {
+  const YAML::Node node = map[key];
+  if (!node) throw InputError(where(file, map, field.empty() ? key : field + "." + key) + "missing required field");
+  return node;
+}
+
+}  // namespace mcopt::yaml

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Installs mcopt's build dependencies from Debian 12 packages. Idempotent:
+# packages already present are skipped, so it is cheap to run before every build.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev            # Eigen 3.4
+  coinor-libipopt-dev      # Ipopt 3.11 (MUMPS)
+  libnlopt-cxx-dev         # NLopt 2.7
+  libsuitesparse-dev       # SuiteSparse 5.12
+  liburdfdom-dev           # urdfdom
+  catch2                   # Catch2 v2
+  libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
+  libbenchmark-dev         # Google Benchmark
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+sudo_cmd=()
+[ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+echo "install-deps: installing ${missing[*]}"
+"${sudo_cmd[@]}" apt-get update -qq
+DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"

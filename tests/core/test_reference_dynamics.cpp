@@ -1,0 +1,78 @@
+// Inverse dynamics against the independent Pinocchio values of ../shared/reference
+// (issue 2 acceptance): torques and reference wrench within 1e-8·(1 + |value|).
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/test_support.hpp"
+#include "core/inverse_dynamics.hpp"
+
+using namespace mcopt;
+
+namespace {
+
+Eigen::VectorXd toVector(const nlohmann::json& array) {
+  Eigen::VectorXd v(array.size());
+  for (std::size_t i = 0; i < array.size(); ++i) v[static_cast<Eigen::Index>(i)] = array[i].get<double>();
+  return v;
+}
+
+// The reference names the robot folder; of its URDFs, the one whose actuated joints are
+// exactly the reference's joint names (talos/ holds a reduced and a full model).
+RobotModel robotFor(const nlohmann::json& ref) {
+  const auto folder = test::sharedDir() / "robots" / ref["robot"].get<std::string>();
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().extension() != ".urdf") continue;
+    RobotModel robot = loadUrdfFile(entry.path());
+    bool same = robot.jointCount() == static_cast<int>(ref["joint_names"].size());
+    for (const auto& name : ref["joint_names"]) same = same && robot.findJoint(name) >= 0;
+    if (same) return robot;
+  }
+  FAIL("no URDF in " << folder << " has the reference's joints");
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("inverse dynamics matches the Pinocchio reference values", "[dynamics][reference]") {
+  const auto referenceDir = test::sharedDir() / "reference/pinocchio";
+  int filesChecked = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(referenceDir)) {
+    if (entry.path().extension() != ".json") continue;
+    std::ifstream in(entry.path());
+    const nlohmann::json ref = nlohmann::json::parse(in);
+    const RobotModel robot = robotFor(ref);
+    const std::string referenceBody = ref["reference_body"] == "root" ? robot.frames[0].name
+                                                                        : ref["reference_body"].get<std::string>();
+    const auto& pose = ref["reference_pose"];
+    RigidTransform referencePose;
+    referencePose.translation = toVector(pose["position"]);
+    const auto quat = toVector(pose["quaternion_xyzw"]);
+    referencePose.rotation = rotationFromQuaternionXyzw(quat[0], quat[1], quat[2], quat[3]);
+    const DynamicsModel model(robot, referenceBody, referencePose, toVector(ref["gravity"]));
+    DynamicsData data(model);
+
+    std::vector<int> columns;
+    for (const auto& name : ref["joint_names"]) columns.push_back(robot.jointIndex(name));
+    REQUIRE(static_cast<int>(columns.size()) == robot.jointCount());
+
+    for (const auto& state : ref["states"]) {
+      Eigen::VectorXd q(robot.jointCount()), v(robot.jointCount()), a(robot.jointCount());
+      const auto qRef = toVector(state["q"]), vRef = toVector(state["v"]), aRef = toVector(state["a"]);
+      for (std::size_t k = 0; k < columns.size(); ++k) {
+        q[columns[k]] = qRef[static_cast<Eigen::Index>(k)];
+        v[columns[k]] = vRef[static_cast<Eigen::Index>(k)];
+        a[columns[k]] = aRef[static_cast<Eigen::Index>(k)];
+      }
+      inverseDynamics(model, data, q, v, a);
+      Eigen::VectorXd tau(robot.jointCount());
+      for (std::size_t k = 0; k < columns.size(); ++k) tau[static_cast<Eigen::Index>(k)] = data.tau[columns[k]];
+      INFO(entry.path().filename().string());
+      CHECK(test::scaledError(tau, toVector(state["tau"])) <= 1e-8);
+      CHECK(test::scaledError(referenceWrenchAtReferenceFrame(model, data), toVector(state["reference_wrench"])) <=
+            1e-8);
+    }
+    ++filesChecked;
+  }
+  CHECK(filesChecked >= 4);
+}
