@@ -1,5 +1,7 @@
 #include "core/dynamics_model.hpp"
 
+#include <algorithm>
+
 #include "core/errors.hpp"
 
 namespace mcopt {
@@ -27,21 +29,18 @@ DynamicsModel::DynamicsModel(RobotModel robot, const std::string& referenceFrame
   positionOfJoint_.assign(robot_.jointCount(), -1);
   positionOfBody_[reference.body] = 0;
 
-  // Pre-order depth-first traversal from the reference body.
-  std::vector<int> stack{reference.body};
+  // Pre-order depth-first traversal from the reference body, joints in URDF order: every
+  // subtree is then the contiguous range [position, subtreeEnd(position)).
+  std::vector<std::pair<int, int>> stack{{reference.body, -1}};  // (body, joint reached through)
   while (!stack.empty()) {
-    const int body = stack.back();
+    const auto [body, via] = stack.back();
     stack.pop_back();
-    const int parentPosition = positionOfBody_[body];
-    // Push in reverse so that joints are visited in URDF order.
-    for (auto it = jointsAtBody[body].rbegin(); it != jointsAtBody[body].rend(); ++it) {
-      const Joint& joint = robot_.joints[*it];
-      const bool reversed = joint.childBody == body;
-      const int next = reversed ? joint.parentBody : joint.childBody;
-      if (positionOfBody_[next] >= 0) continue;  // the edge we came through
+    if (via >= 0) {
+      const Joint& joint = robot_.joints[via];
+      const bool reversed = joint.childBody != body;
       TreeJoint edge;
-      edge.joint = *it;
-      edge.parent = parentPosition;
+      edge.joint = via;
+      edge.parent = positionOfBody_[reversed ? joint.childBody : joint.parentBody];
       edge.prismatic = joint.type == JointType::Prismatic;
       edge.reversed = reversed;
       if (reversed) {
@@ -53,24 +52,34 @@ DynamicsModel::DynamicsModel(RobotModel robot, const std::string& referenceFrame
       }
       edge.beforeIsIdentity = edge.before.isIdentity();
       edge.afterIsIdentity = edge.after.isIdentity();
-      positionOfBody_[next] = static_cast<int>(bodyAtPosition_.size());
-      positionOfJoint_[*it] = positionOfBody_[next];
-      bodyAtPosition_.push_back(next);
+      positionOfBody_[body] = static_cast<int>(bodyAtPosition_.size());
+      positionOfJoint_[via] = positionOfBody_[body];
+      bodyAtPosition_.push_back(body);
       treeJoints_.push_back(edge);
-      stack.push_back(next);
+    }
+    // Push in reverse so that joints pop in URDF order.
+    for (auto it = jointsAtBody[body].rbegin(); it != jointsAtBody[body].rend(); ++it) {
+      const Joint& joint = robot_.joints[*it];
+      const int next = joint.childBody == body ? joint.parentBody : joint.childBody;
+      if (*it == via) continue;  // the edge we came through
+      stack.emplace_back(next, *it);
     }
   }
-  // Re-order depth-first pushes into a proper parent-before-child order is already
-  // guaranteed: a body is numbered when first reached from its parent.
+  subtreeEnd_.assign(nb, 0);
+  for (int position = nb - 1; position >= 0; --position) {
+    subtreeEnd_[position] = std::max(subtreeEnd_[position], position + 1);
+    if (position > 0) {
+      const int parent = treeJoints_[position].parent;
+      subtreeEnd_[parent] = std::max(subtreeEnd_[parent], subtreeEnd_[position]);
+    }
+  }
   inertias_.resize(nb);
   for (int position = 0; position < nb; ++position) inertias_[position] = robot_.bodies[bodyAtPosition_[position]].inertia;
 }
 
 bool DynamicsModel::supports(int joint, int position) const {
   const int jointPosition = positionOfJoint_[joint];
-  for (int p = position; p > 0; p = treeJoints_[p].parent)
-    if (p == jointPosition) return true;
-  return false;
+  return jointPosition <= position && position < subtreeEnd_[jointPosition];
 }
 
 }  // namespace mcopt

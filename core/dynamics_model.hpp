@@ -58,6 +58,9 @@ class DynamicsModel {
   int framePosition(int frame) const { return positionOfBody_[robot_.frames[frame].body]; }
   const RigidTransform& framePlacement(int frame) const { return robot_.frames[frame].placement; }
 
+  /// Tree positions are in depth-first pre-order: the subtree of `position` (the bodies it
+  /// carries away from the reference body) is [position, subtreeEnd(position)).
+  int subtreeEnd(int position) const { return subtreeEnd_[position]; }
   /// Whether joint j lies on the path from the reference body to the body at `position`.
   bool supports(int joint, int position) const;
 
@@ -65,7 +68,7 @@ class DynamicsModel {
   RobotModel robot_;
   std::vector<TreeJoint> treeJoints_;
   std::vector<BodyInertia> inertias_;
-  std::vector<int> bodyAtPosition_, positionOfBody_, positionOfJoint_;
+  std::vector<int> bodyAtPosition_, positionOfBody_, positionOfJoint_, subtreeEnd_;
   int referenceFrame_ = 0;
   RigidTransform referencePose_, rootPose_;
   Vector3 gravity_;

@@ -5,7 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/test_support.hpp"
-#include "core/inverse_dynamics.hpp"
+#include "core/dynamics_derivatives.hpp"
 
 using namespace mcopt;
 
@@ -32,6 +32,12 @@ RobotModel robotFor(const nlohmann::json& ref) {
   return {};
 }
 
+Eigen::MatrixXd toMatrix(const nlohmann::json& rows) {
+  Eigen::MatrixXd m(rows.size(), rows[0].size());
+  for (std::size_t r = 0; r < rows.size(); ++r) m.row(static_cast<Eigen::Index>(r)) = toVector(rows[r]).transpose();
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("inverse dynamics matches the Pinocchio reference values", "[dynamics][reference]") {
@@ -51,6 +57,8 @@ TEST_CASE("inverse dynamics matches the Pinocchio reference values", "[dynamics]
     referencePose.rotation = rotationFromQuaternionXyzw(quat[0], quat[1], quat[2], quat[3]);
     const DynamicsModel model(robot, referenceBody, referencePose, toVector(ref["gravity"]));
     DynamicsData data(model);
+    DynamicsDerivatives derivatives(model);
+    Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchDerivative;
 
     std::vector<int> columns;
     for (const auto& name : ref["joint_names"]) columns.push_back(robot.jointIndex(name));
@@ -71,6 +79,32 @@ TEST_CASE("inverse dynamics matches the Pinocchio reference values", "[dynamics]
       CHECK(test::scaledError(tau, toVector(state["tau"])) <= 1e-8);
       CHECK(test::scaledError(referenceWrenchAtReferenceFrame(model, data), toVector(state["reference_wrench"])) <=
             1e-8);
+
+      // Derivatives, where the reference carries them (rows: outputs, columns: its joint order).
+      inverseDynamicsDerivatives(model, data, derivatives, q, v, a);
+      const std::pair<const char*, const Eigen::MatrixXd*> tauDerivatives[] = {
+          {"dtau_dq", &derivatives.dtauDq}, {"dtau_dv", &derivatives.dtauDv}, {"dtau_da", &derivatives.dtauDa}};
+      for (const auto& [key, analytic] : tauDerivatives) {
+        if (!state.contains(key)) continue;
+        const Eigen::MatrixXd expected = toMatrix(state[key]);
+        Eigen::MatrixXd ours(expected.rows(), expected.cols());
+        for (std::size_t r = 0; r < columns.size(); ++r)
+          for (std::size_t c = 0; c < columns.size(); ++c)
+            ours(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = (*analytic)(columns[r], columns[c]);
+        INFO(key);
+        CHECK(test::scaledError(ours, expected) <= 1e-6);
+      }
+      const std::pair<const char*, const Eigen::Matrix<double, 6, Eigen::Dynamic>*> wrenchDerivatives[] = {
+          {"dwrench_dq", &derivatives.dwrenchDq}, {"dwrench_dv", &derivatives.dwrenchDv}, {"dwrench_da", &derivatives.dwrenchDa}};
+      for (const auto& [key, analytic] : wrenchDerivatives) {
+        if (!state.contains(key)) continue;
+        wrenchDerivativeAtReferenceFrame(model, *analytic, wrenchDerivative);
+        const Eigen::MatrixXd expected = toMatrix(state[key]);
+        Eigen::MatrixXd ours(6, expected.cols());
+        for (std::size_t c = 0; c < columns.size(); ++c) ours.col(static_cast<Eigen::Index>(c)) = wrenchDerivative.col(columns[c]);
+        INFO(key);
+        CHECK(test::scaledError(ours, expected) <= 1e-6);
+      }
     }
     ++filesChecked;
   }

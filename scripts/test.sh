@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs the dependencies, then builds and runs the whole test suite twice:
+# Release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer.
+# Set MCOPT_SKIP_SANITIZE=1 to run only the first.
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+jobs="$(nproc)"
+"$root/scripts/install-deps.sh"
+
+cmake --preset release -S "$root"
+cmake --build "$root/build/release" --parallel "$jobs"
+(cd "$root/build/release" && ctest --output-on-failure --parallel "$jobs")
+
+if [ "${MCOPT_SKIP_SANITIZE:-0}" != "1" ]; then
+  cmake --preset sanitize -S "$root"
+  cmake --build "$root/build/sanitize" --parallel "$jobs"
+  (cd "$root/build/sanitize" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+     ctest --output-on-failure --parallel "$jobs")
+fi
