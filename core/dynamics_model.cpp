@@ -52,6 +52,13 @@ DynamicsModel::DynamicsModel(RobotModel robot, const std::string& referenceFrame
       }
       edge.beforeIsIdentity = edge.before.isIdentity();
       edge.afterIsIdentity = edge.after.isIdentity();
+      edge.beforeIsTranslation = edge.before.rotation == Matrix3::Identity();
+      edge.afterIsTranslation = edge.after.rotation == Matrix3::Identity();
+      for (int k = 0; k < 3; ++k)
+        if (std::abs(std::abs(edge.axis[k]) - 1.0) < 1e-15) {
+          edge.axisIndex = k;
+          edge.axisSign = edge.axis[k] > 0 ? 1.0 : -1.0;
+        }
       positionOfBody_[body] = static_cast<int>(bodyAtPosition_.size());
       positionOfJoint_[via] = positionOfBody_[body];
       bodyAtPosition_.push_back(body);

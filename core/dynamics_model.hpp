@@ -25,6 +25,11 @@ struct TreeJoint {
   RigidTransform after;
   bool afterIsIdentity = true;
   bool beforeIsIdentity = true;
+  bool beforeIsTranslation = true;  ///< before.rotation is the identity
+  bool afterIsTranslation = true;   ///< after.rotation is the identity
+  /// 0, 1, 2 when `axis` is ±x, ±y, ±z (then axisSign is that sign), −1 for a general axis.
+  int axisIndex = -1;
+  double axisSign = 1.0;
 };
 
 class DynamicsModel {

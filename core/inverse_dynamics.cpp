@@ -14,37 +14,48 @@ DynamicsData::DynamicsData(const DynamicsModel& model) {
 
 namespace {
 
-// Pose of the body at `i` from its parent's (formulation.md (3.2)–(3.5)).
+// rotation ← rotation · Rot(e_k, angle) for a coordinate axis: two columns mix.
+inline void rotateAboutCoordinateAxis(Matrix3& rotation, int k, double s, double c) {
+  const int i = (k + 1) % 3, j = (k + 2) % 3;  // Rot(e_k) turns e_i toward e_j
+  const Vector3 ci = rotation.col(i), cj = rotation.col(j);
+  rotation.col(i) = c * ci + s * cj;
+  rotation.col(j) = c * cj - s * ci;
+}
+
+// Pose of the body at `i` from its parent's (formulation.md (3.2)–(3.5)). Placements that
+// are pure translations (most of them) skip the rotation products; joints about a
+// coordinate axis rotate two columns: this halves the cost of a sample (measured).
 inline void placeBody(const TreeJoint& edge, double qj, DynamicsData& d, int i) {
   const int p = edge.parent;
-  Matrix3 jointRotation;
-  Vector3 jointOrigin;
-  if (edge.beforeIsIdentity) {
-    jointRotation = d.rotation[p];
-    jointOrigin = d.position[p];
-  } else {
-    jointRotation.noalias() = d.rotation[p] * edge.before.rotation;
-    jointOrigin.noalias() = d.rotation[p] * edge.before.translation;
-    jointOrigin += d.position[p];
+  Matrix3 jointRotation = d.rotation[p];
+  Vector3 jointOrigin = d.position[p];
+  if (!edge.beforeIsIdentity) {
+    jointOrigin.noalias() += d.rotation[p] * edge.before.translation;
+    if (!edge.beforeIsTranslation) jointRotation = d.rotation[p] * edge.before.rotation;
   }
   const Vector3 axis = jointRotation * edge.axis;
   d.jointAxis[i] = axis;
-  Matrix3 moved;
   if (edge.prismatic) {
-    moved = jointRotation;
     jointOrigin += qj * axis;
     d.jointMoment[i] = axis;
   } else {
-    moved.noalias() = jointRotation * rotationAboutAxis(edge.axis, qj);
     d.jointMoment[i] = jointOrigin.cross(axis);
+    if (edge.axisIndex >= 0) {
+      rotateAboutCoordinateAxis(jointRotation, edge.axisIndex, edge.axisSign * std::sin(qj), std::cos(qj));
+    } else {
+      jointRotation = jointRotation * rotationAboutAxis(edge.axis, qj);
+    }
   }
   if (edge.afterIsIdentity) {
-    d.rotation[i] = moved;
+    d.rotation[i] = jointRotation;
     d.position[i] = jointOrigin;
   } else {
-    d.rotation[i].noalias() = moved * edge.after.rotation;
-    d.position[i].noalias() = moved * edge.after.translation;
+    d.position[i].noalias() = jointRotation * edge.after.translation;
     d.position[i] += jointOrigin;
+    if (edge.afterIsTranslation)
+      d.rotation[i] = jointRotation;
+    else
+      d.rotation[i].noalias() = jointRotation * edge.after.rotation;
   }
 }
 
