@@ -5,7 +5,7 @@
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
 #include "core/atomic_file.hpp"
-#include "core/inverse_dynamics.hpp"
+#include "core/dynamics_derivatives.hpp"
 
 namespace mcopt::cli {
 
@@ -14,6 +14,7 @@ namespace {
 struct DynamicsOptions {
   std::string robot, referenceBody, states, out;
   bool allowNonPhysicalInertia = false;
+  bool derivatives = false;
 };
 
 RigidTransform readPose(const std::filesystem::path& file, const json_io::Json& node, const std::string& field) {
@@ -69,6 +70,23 @@ int runDynamics(const DynamicsOptions& o) {
   const std::string referenceBody = o.referenceBody.empty() ? robot.frames[0].name : o.referenceBody;
   const DynamicsModel model(robot, referenceBody, referencePose, gravity);
   DynamicsData data(model);
+  DynamicsDerivatives derivatives(model);
+  Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchDerivative;
+  // Rows: outputs in joint_names order (or wrench components); columns: inputs in joint_names order.
+  auto selectTau = [&](const Eigen::MatrixXd& full) {
+    Eigen::MatrixXd out(static_cast<Eigen::Index>(columns.size()), static_cast<Eigen::Index>(columns.size()));
+    for (std::size_t r = 0; r < columns.size(); ++r)
+      for (std::size_t c = 0; c < columns.size(); ++c)
+        out(static_cast<Eigen::Index>(r), static_cast<Eigen::Index>(c)) = full(columns[r], columns[c]);
+    return json_io::matrixToJson(out);
+  };
+  auto selectWrench = [&](const Eigen::Matrix<double, 6, Eigen::Dynamic>& atOrigin) {
+    wrenchDerivativeAtReferenceFrame(model, atOrigin, wrenchDerivative);
+    Eigen::MatrixXd out(6, static_cast<Eigen::Index>(columns.size()));
+    for (std::size_t c = 0; c < columns.size(); ++c)
+      out.col(static_cast<Eigen::Index>(c)) = wrenchDerivative.col(columns[c]);
+    return json_io::matrixToJson(out);
+  };
 
   if (!input.contains("states") || !input["states"].is_array())
     throw InputError(file.string() + ": states: expected a list of {q, v, a}");
@@ -88,10 +106,22 @@ int runDynamics(const DynamicsOptions& o) {
       Eigen::VectorXd& target = key[0] == 'q' ? q : key[0] == 'v' ? v : a;
       for (long k = 0; k < count; ++k) target[columns[static_cast<std::size_t>(k)]] = values[k];
     }
-    inverseDynamics(model, data, q, v, a);
+    if (o.derivatives)
+      inverseDynamicsDerivatives(model, data, derivatives, q, v, a);
+    else
+      inverseDynamics(model, data, q, v, a);
     for (long k = 0; k < count; ++k) tau[k] = data.tau[columns[static_cast<std::size_t>(k)]];
-    results.push_back({{"tau", json_io::toJson(tau)},
-                       {"reference_wrench", json_io::toJson(referenceWrenchAtReferenceFrame(model, data))}});
+    json_io::Json result = {{"tau", json_io::toJson(tau)},
+                            {"reference_wrench", json_io::toJson(referenceWrenchAtReferenceFrame(model, data))}};
+    if (o.derivatives) {
+      result["dtau_dq"] = selectTau(derivatives.dtauDq);
+      result["dtau_dv"] = selectTau(derivatives.dtauDv);
+      result["dtau_da"] = selectTau(derivatives.dtauDa);
+      result["dwrench_dq"] = selectWrench(derivatives.dwrenchDq);
+      result["dwrench_dv"] = selectWrench(derivatives.dwrenchDv);
+      result["dwrench_da"] = selectWrench(derivatives.dwrenchDa);
+    }
+    results.push_back(result);
   }
   json_io::Json out;
   out["joint_names"] = names;
@@ -113,6 +143,8 @@ Runner addDynamics(CLI::App& command) {
                      "link held fixed at reference_pose (default: the URDF root); any link, sole frames included");
   command.add_option("--states", o->states, "input JSON (docs/file-formats.md)")->required();
   command.add_option("--out", o->out, "output JSON (default: standard output)");
+  command.add_flag("--derivatives", o->derivatives,
+                   "add dtau_dq, dtau_dv, dtau_da, dwrench_dq, dwrench_dv, dwrench_da (exact, analytic)");
   command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,
                    "load inertias that break positivity or the triangle inequality, with a warning");
   return [o] { return runDynamics(*o); };

@@ -81,4 +81,21 @@ MotorPower motorPower(const ActuatorParameters& actuator, double sharpness, doub
   return out;
 }
 
+MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, double sharpness, double torque,
+                                            double velocity, double acceleration) {
+  const MotorPower p = motorPower(actuator, sharpness, torque, velocity, acceleration);
+  const double n = actuator.gearRatio, k = actuator.torqueConstant;
+  const double motorSpeed = n * velocity;
+  const double x = sharpness * motorSpeed;
+  const double frictionSlope =
+      actuator.viscousFriction + actuator.dryFriction * (2.0 / std::numbers::pi) * sharpness / (1.0 + x * x);
+  const double dPdMotorTorque = motorSpeed + 2.0 * (actuator.resistance / (k * k)) * p.motorTorque;
+  MotorPowerDerivatives d;
+  d.power = p.power;
+  d.dTorque = dPdMotorTorque / n;
+  d.dVelocity = n * p.motorTorque + dPdMotorTorque * n * frictionSlope;
+  d.dAcceleration = dPdMotorTorque * actuator.rotorInertia * n;
+  return d;
+}
+
 }  // namespace mcopt

@@ -54,4 +54,14 @@ struct MotorPower {
 MotorPower motorPower(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
                       double acceleration);
 
+struct MotorPowerDerivatives {
+  double power = 0.0;
+  double dTorque = 0.0;        ///< ∂P/∂Γ = (Ω + 2 R Γem / K²) / N
+  double dVelocity = 0.0;      ///< ∂P/∂q̇ = N Γem + (Ω + 2 R Γem / K²) N Γ_fric'(Ω)
+  double dAcceleration = 0.0;  ///< ∂P/∂q̈ = (Ω + 2 R Γem / K²) I_m N
+};
+
+MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, double sharpness, double torque,
+                                            double velocity, double acceleration);
+
 }  // namespace mcopt

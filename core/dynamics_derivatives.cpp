@@ -13,7 +13,7 @@ DynamicsDerivatives::DynamicsDerivatives(const DynamicsModel& model) {
   dwrenchDa.setZero(6, n);
   inertia.assign(nb, Matrix6::Zero());
   compositeInertia.assign(nb, Matrix6::Zero());
-  for (auto* v : {&motion, &twist, &acceleration, &momentum, &bodyWrench, &compositeWrench, &accumulated})
+  for (auto* v : {&motion, &twist, &acceleration, &momentum, &inertiaTimesAcceleration, &compositeWrench, &accumulated})
     v->assign(nb, Vector6::Zero());
 }
 
@@ -67,9 +67,8 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
       d.motion[i].setZero();
     }
     d.momentum[i].noalias() = d.inertia[i] * d.twist[i];
-    d.bodyWrench[i].noalias() = d.inertia[i] * d.acceleration[i];
-    d.bodyWrench[i] += forceCross(d.twist[i], d.momentum[i]);
-    d.compositeWrench[i] = d.bodyWrench[i];
+    d.inertiaTimesAcceleration[i].noalias() = d.inertia[i] * d.acceleration[i];
+    d.compositeWrench[i] = d.inertiaTimesAcceleration[i] + forceCross(d.twist[i], d.momentum[i]);
     d.compositeInertia[i] = d.inertia[i];
   }
   for (int i = nb - 1; i > 0; --i) {
@@ -85,16 +84,18 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
     const Vector6 sjCrossVj = motionCross(sj, vj);
     const int end = model.subtreeEnd(pj);
 
-    // ∂/∂q_j
+    // ∂/∂q_j. With c = S_j × V_j the products regroup as
+    //   ∂(I A) = S ×* (I A) + I ((V_i − V_j) × c − S × A_j),   ∂(I V) = S ×* (I V) − I c
+    // so each body costs two 6 × 6 products.
+    const Vector6 sjCrossAj = motionCross(sj, aj);
     for (int i = pj; i < end; ++i) {
       const Matrix6& I = d.inertia[i];
       const Vector6& vi = d.twist[i];
       const Vector6 dV = motionCross(sj, vi - vj);
-      const Vector6 dA = motionCross(sj, d.acceleration[i] - aj) + motionCross(vi - vj, sjCrossVj);
-      // ∂(I A) = (S ×* I − I S ×) A + I ∂A;  ∂(V ×* I V) = ∂V ×* h + V ×* (∂I V + I ∂V)
-      const Vector6 dMomentum = forceCross(sj, d.momentum[i]) + I * (dV - motionCross(sj, vi));
-      d.accumulated[i] = forceCross(sj, I * d.acceleration[i]) + I * (dA - motionCross(sj, d.acceleration[i])) +
-                         forceCross(dV, d.momentum[i]) + forceCross(vi, dMomentum);
+      const Vector6 dMomentum = forceCross(sj, d.momentum[i]) - I * sjCrossVj;
+      d.accumulated[i] = forceCross(sj, d.inertiaTimesAcceleration[i]) +
+                         I * (motionCross(vi - vj, sjCrossVj) - sjCrossAj) + forceCross(dV, d.momentum[i]) +
+                         forceCross(vi, dMomentum);
     }
     accumulateSubtree(model, d, pj);
     scatterDirection<true>(model, d, pj, d.dtauDq, d.dwrenchDq);
@@ -109,9 +110,16 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
     accumulateSubtree(model, d, pj);
     scatterDirection<false>(model, d, pj, d.dtauDv, d.dwrenchDv);
 
-    // ∂/∂q̈_j: the mass matrix, Γ_i = S_i · I^c S_j.
-    for (int i = pj; i < end; ++i) d.accumulated[i].noalias() = d.compositeInertia[i] * sj;
-    scatterDirection<false>(model, d, pj, d.dtauDa, d.dwrenchDa);
+    // ∂/∂q̈_j: the mass matrix, CRBA-style. F = I^c_j S_j; M(a, j) = M(j, a) = S_a · F for
+    // j and each joint a between j and the reference body; W0 takes F.
+    const Vector6 force = d.compositeInertia[pj] * sj;
+    const int column = edges[pj].joint;
+    for (int p = pj; p > 0; p = edges[p].parent) {
+      const double value = d.motion[p].dot(force);
+      d.dtauDa(edges[p].joint, column) = value;
+      d.dtauDa(column, edges[p].joint) = value;
+    }
+    d.dwrenchDa.col(column) = force;
   }
 }
 

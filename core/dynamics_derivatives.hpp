@@ -30,7 +30,7 @@ struct DynamicsDerivatives {
   // Workspace, by tree position.
   std::vector<Matrix6> inertia;           ///< world spatial inertia of each body
   std::vector<Matrix6> compositeInertia;  ///< summed over the subtree
-  std::vector<Vector6> motion, twist, acceleration, momentum, bodyWrench, compositeWrench, accumulated;
+  std::vector<Vector6> motion, twist, acceleration, momentum, inertiaTimesAcceleration, compositeWrench, accumulated;
 };
 
 /// Runs inverseDynamics (filling `data`) and its derivatives (filling `derivatives`).

@@ -73,7 +73,7 @@ TEST_CASE("dynamics reproduces the Pinocchio reference file through the command"
   for (const auto& s : ref["states"]) input["states"].push_back({{"q", s["q"]}, {"v", s["v"]}, {"a", s["a"]}});
   const auto file = dir.write("in.json", input.dump());
   const auto ok = test::runMcopt("dynamics --robot " + test::quoted(test::sharedDir() / "robots/jvrc1/jvrc1.urdf") +
-                                 " --reference-body L_ANKLE_P_S --states " + test::quoted(file));
+                                 " --reference-body L_ANKLE_P_S --derivatives --states " + test::quoted(file));
   REQUIRE(ok.exitCode == 0);
   const Json out = Json::parse(ok.output);
   for (std::size_t s = 0; s < ref["states"].size(); ++s)
@@ -82,6 +82,21 @@ TEST_CASE("dynamics reproduces the Pinocchio reference file through the command"
         const double expected = ref["states"][s][key][k];
         CHECK(std::abs(out["results"][s][key][k].get<double>() - expected) <= 1e-8 * (1 + std::abs(expected)));
       }
+  // --derivatives: row-major, rows outputs, columns inputs, both in joint_names order.
+  for (std::size_t s = 0; s < ref["states"].size(); ++s)
+    for (const char* key : {"dtau_dq", "dtau_dv", "dtau_da", "dwrench_dq", "dwrench_dv", "dwrench_da"}) {
+      const auto& expected = ref["states"][s][key];
+      const auto& ours = out["results"][s][key];
+      REQUIRE(ours.size() == expected.size());
+      double worst = 0.0;
+      for (std::size_t row = 0; row < expected.size(); ++row)
+        for (std::size_t c = 0; c < expected[row].size(); ++c) {
+          const double e = expected[row][c];
+          worst = std::max(worst, std::abs(ours[row][c].get<double>() - e) / (1 + std::abs(e)));
+        }
+      INFO(key);
+      CHECK(worst <= 1e-6);
+    }
 }
 #endif
 

@@ -1,0 +1,105 @@
+#include "core/trajectory_gradient.hpp"
+
+#include <omp.h>
+
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+TrajectoryGradientEvaluator::TrajectoryGradientEvaluator(const DynamicsModel& model, ActuatorSet actuators,
+                                                         SampledTrajectory samples)
+    : model_(model), actuators_(std::move(actuators)), samples_(std::move(samples)) {
+  if (static_cast<int>(actuators_.joints.size()) != model.jointCount() ||
+      samples_.parametrization().jointCount() != model.jointCount())
+    throw InputError("actuators, trajectory and robot disagree on the number of joints");
+  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model));
+  const int n = model.jointCount(), p = samples_.parametrization().parameterCount();
+  for (ThreadWorkspace& w : workspaces_) {
+    w.energyGradient.setZero(p);
+    for (Eigen::VectorXd* v : {&w.powerTorque, &w.rowQ, &w.rowV, &w.rowA}) v->setZero(n);
+  }
+}
+
+void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
+                                           TrajectoryResult& r, TrajectoryGradient& g) {
+  const auto& parametrization = samples_.parametrization();
+  const int n = model_.jointCount(), count = samples_.sampleCount(), m = parametrization.parametersPerJoint();
+  if (parameters.size() != parametrization.parameterCount() || !parameters.allFinite())
+    throw InputError("expected " + std::to_string(parametrization.parameterCount()) + " finite spline parameters");
+  if (!(duration > 0.0) || !std::isfinite(duration)) throw InputError("duration must be positive and finite");
+  r.time.resize(count);
+  for (Eigen::MatrixXd* x : {&r.q, &r.v, &r.a, &r.tau, &r.power}) x->resize(n, count);
+  r.referenceWrench.resize(6, count);
+  g.torque.resize(static_cast<std::size_t>(count));
+  parametrization.controlPoints(parameters, controlPoints_);
+  for (ThreadWorkspace& w : workspaces_) {
+    w.energyGradient.setZero();
+    w.energyDT = 0.0;
+  }
+  const double dt = duration / (count - 1);
+
+#pragma omp parallel for schedule(static)
+  for (int s = 0; s < count; ++s) {
+    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    r.time[s] = samples_.time(s, duration);
+    samples_.evaluate(s, controlPoints_, duration, r.q.col(s), r.v.col(s), r.a.col(s));
+    inverseDynamicsDerivatives(model_, w.data, w.derivatives, r.q.col(s), r.v.col(s), r.a.col(s));
+    r.tau.col(s) = w.data.tau;
+    r.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
+    const DynamicsDerivatives& d = w.derivatives;
+
+    // Torque Jacobian block over the local parameters.
+    const LocalParameterWeights& weights = samples_.weights(s);
+    const int k = weights.count;
+    SampleTorqueJacobian& block = g.torque[static_cast<std::size_t>(s)];
+    block.parameters.resize(n * k);
+    block.dtauDx.resize(n, n * k);
+    for (int j = 0; j < n; ++j)
+      for (int l = 0; l < k; ++l) {
+        block.parameters[j * k + l] = j * m + weights.parameter[l];
+        block.dtauDx.col(j * k + l).noalias() = weights.value[l] * d.dtauDq.col(j);
+        block.dtauDx.col(j * k + l).noalias() += (weights.d1[l] / duration) * d.dtauDv.col(j);
+        block.dtauDx.col(j * k + l).noalias() += (weights.d2[l] / (duration * duration)) * d.dtauDa.col(j);
+      }
+    block.dtauDT.noalias() = d.dtauDv * r.v.col(s);
+    block.dtauDT.noalias() += 2.0 * d.dtauDa * r.a.col(s);
+    block.dtauDT /= -duration;
+
+    // Energy: trapezoid weight c_s Δt on Σ_j max(P, 0).
+    const double weight = (s == 0 || s == count - 1) ? 0.5 * dt : dt;
+    w.rowV.setZero();
+    w.rowA.setZero();
+    double sampleEnergy = 0.0, directDT = 0.0;
+    for (int j = 0; j < n; ++j) {
+      const MotorPowerDerivatives p = motorPowerDerivatives(actuators_.joints[j], actuators_.frictionSharpness,
+                                                            w.data.tau[j], r.v(j, s), r.a(j, s));
+      r.power(j, s) = p.power;
+      const bool active = p.power > 0.0;
+      sampleEnergy += active ? p.power : 0.0;
+      w.powerTorque[j] = active ? weight * p.dTorque : 0.0;
+      w.rowV[j] = active ? weight * p.dVelocity : 0.0;
+      w.rowA[j] = active ? weight * p.dAcceleration : 0.0;
+      directDT -= w.rowV[j] * r.v(j, s) + 2.0 * w.rowA[j] * r.a(j, s);
+    }
+    // Rows ∂E_s/∂(q, q̇, q̈) = gᵀ ∂Γ/∂(·) + direct terms.
+    w.rowQ.noalias() = d.dtauDq.transpose() * w.powerTorque;
+    w.rowV.noalias() += d.dtauDv.transpose() * w.powerTorque;
+    w.rowA.noalias() += d.dtauDa.transpose() * w.powerTorque;
+    for (int j = 0; j < n; ++j)
+      for (int l = 0; l < k; ++l)
+        w.energyGradient[j * m + weights.parameter[l]] += w.rowQ[j] * weights.value[l] +
+                                                         w.rowV[j] * weights.d1[l] / duration +
+                                                         w.rowA[j] * weights.d2[l] / (duration * duration);
+    // ∂/∂T: the weight Δt ∝ T, and q̇, q̈ scale as 1/T, 1/T² (through Γ too).
+    w.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(block.dtauDT);
+  }
+  r.energy = positiveEnergy(r.power, r.time);
+  g.energyGradient.setZero(parametrization.parameterCount());
+  g.energyDT = 0.0;
+  for (const ThreadWorkspace& w : workspaces_) {
+    g.energyGradient += w.energyGradient;
+    g.energyDT += w.energyDT;
+  }
+}
+
+}  // namespace mcopt
