@@ -11,38 +11,38 @@ DynamicsDerivatives::DynamicsDerivatives(const DynamicsModel& model) {
   dwrenchDq.setZero(6, n);
   dwrenchDv.setZero(6, n);
   dwrenchDa.setZero(6, n);
-  inertia.assign(nb, Matrix6::Zero());
-  compositeInertia.assign(nb, Matrix6::Zero());
-  for (auto* v : {&motion, &twist, &acceleration, &momentum, &inertiaTimesAcceleration, &compositeWrench, &accumulated})
+  terms.assign(nb, BodyTerms{});
+  for (auto* v : {&motion, &twist, &acceleration, &momentum, &inertiaTimesAcceleration, &wrench, &alpha, &beta, &gamma})
     v->assign(nb, Vector6::Zero());
 }
 
 namespace {
 
-// Γ derivative columns for one direction once the subtree sums G of ∂F are in `acc`:
-// inside the subtree ∂Γ_i = (S_j × S_i)·F^c_i (position only) + S_i·G_i; on the path to the
-// root ∂Γ_a = S_a·G_j (S_a does not move); W0 takes G_j.
-template <bool kPositionDerivative>
-void scatterDirection(const DynamicsModel& model, const DynamicsDerivatives& d, int pj, Eigen::MatrixXd& dtau,
-                      Eigen::Matrix<double, 6, Eigen::Dynamic>& dwrench) {
-  const auto& edges = model.treeJoints();
-  const int column = edges[pj].joint;
-  const Vector6& sj = d.motion[pj];
-  const int end = model.subtreeEnd(pj);
-  for (int i = pj; i < end; ++i) {
-    double value = d.motion[i].dot(d.accumulated[i]);
-    if (kPositionDerivative && i != pj) value += motionCross(sj, d.motion[i]).dot(d.compositeWrench[i]);
-    dtau(edges[i].joint, column) = value;
-  }
-  for (int p = edges[pj].parent; p > 0; p = edges[p].parent)
-    dtau(edges[p].joint, column) = d.motion[p].dot(d.accumulated[pj]);
-  dwrench.col(column) = d.accumulated[pj];
+using Terms = DynamicsDerivatives::BodyTerms;
+
+MCOPT_ALWAYS_INLINE Vector6 inertiaTimes(const Terms& t, const Vector6& x) {
+  Vector6 out;
+  out.head<3>() = t.mass * x.head<3>() - t.massCom.cross(x.tail<3>());
+  out.tail<3>().noalias() = t.rotational * x.tail<3>();
+  out.tail<3>() += t.massCom.cross(x.head<3>());
+  return out;
 }
 
-// Sums `accumulated` over the subtree of pj, in place (children follow parents in pre-order).
-void accumulateSubtree(const DynamicsModel& model, DynamicsDerivatives& d, int pj) {
-  const auto& edges = model.treeJoints();
-  for (int i = model.subtreeEnd(pj) - 1; i > pj; --i) d.accumulated[edges[i].parent] += d.accumulated[i];
+// Y x with Y = [[0, [f]×], [−[f]×, E]]; f is the linear momentum of the same bodies.
+MCOPT_ALWAYS_INLINE Vector6 velocityCouplingTimes(const Terms& t, const Vector3& linearMomentum, const Vector6& x) {
+  Vector6 out;
+  out.head<3>() = linearMomentum.cross(x.tail<3>());
+  out.tail<3>().noalias() = t.velocityBlock * x.tail<3>();
+  out.tail<3>() -= linearMomentum.cross(x.head<3>());
+  return out;
+}
+
+// Z x with Z = [[0, [z₁]×], [[z₁]×, [z₂]×]].
+MCOPT_ALWAYS_INLINE Vector6 momentumCouplingTimes(const Terms& t, const Vector6& x) {
+  Vector6 out;
+  out.head<3>() = t.z1.cross(x.tail<3>());
+  out.tail<3>() = t.z1.cross(x.head<3>()) + t.z2.cross(x.tail<3>());
+  return out;
 }
 
 }  // namespace
@@ -54,10 +54,15 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
   const auto& inertias = model.inertias();
   const int nb = model.bodyCount();
 
-  // World-frame spatial quantities of every body.
+  // Per body: I, V, A, h = I V, P = I A, F = P + V ×* h and the blocks of Y and Z.
   for (int i = 0; i < nb; ++i) {
     const Matrix3& R = data.rotation[i];
-    d.inertia[i] = spatialInertia(inertias[i].mass, data.comPosition[i], R * inertias[i].inertiaAboutCom * R.transpose());
+    Terms& t = d.terms[i];
+    const Vector3& c = data.comPosition[i];
+    t.mass = inertias[i].mass;
+    t.massCom = t.mass * c;
+    t.rotational.noalias() = R * inertias[i].inertiaAboutCom * R.transpose();
+    t.rotational += t.mass * (c.squaredNorm() * Matrix3::Identity() - c * c.transpose());
     d.twist[i] << data.linearVelocity[i], data.angularVelocity[i];
     d.acceleration[i] << data.linearAcceleration[i], data.angularAcceleration[i];
     if (i > 0) {
@@ -66,60 +71,75 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
     } else {
       d.motion[i].setZero();
     }
-    d.momentum[i].noalias() = d.inertia[i] * d.twist[i];
-    d.inertiaTimesAcceleration[i].noalias() = d.inertia[i] * d.acceleration[i];
-    d.compositeWrench[i] = d.inertiaTimesAcceleration[i] + forceCross(d.twist[i], d.momentum[i]);
-    d.compositeInertia[i] = d.inertia[i];
+    d.momentum[i] = inertiaTimes(t, d.twist[i]);
+    d.inertiaTimesAcceleration[i] = inertiaTimes(t, d.acceleration[i]);
+    d.wrench[i] = d.inertiaTimesAcceleration[i] + forceCross(d.twist[i], d.momentum[i]);
+    const Vector3 lin = d.twist[i].head<3>(), ang = d.twist[i].tail<3>();
+    const Vector3 f = d.momentum[i].head<3>(), n = d.momentum[i].tail<3>();
+    const Matrix3 jw = t.rotational * skew(ang);
+    t.velocityBlock = lin * t.massCom.transpose() + t.massCom * lin.transpose() -
+                      2.0 * t.massCom.dot(lin) * Matrix3::Identity() + jw + jw.transpose();
+    t.z1 = f.cross(ang);
+    t.z2 = f.cross(lin) + n.cross(ang);
   }
+  // Subtree sums, children before parents (pre-order positions, read backwards).
   for (int i = nb - 1; i > 0; --i) {
-    d.compositeWrench[edges[i].parent] += d.compositeWrench[i];
-    d.compositeInertia[edges[i].parent] += d.compositeInertia[i];
+    const int p = edges[i].parent;
+    Terms& to = d.terms[p];
+    const Terms& from = d.terms[i];
+    to.mass += from.mass;
+    to.massCom += from.massCom;
+    to.rotational += from.rotational;
+    to.velocityBlock += from.velocityBlock;
+    to.z1 += from.z1;
+    to.z2 += from.z2;
+    d.momentum[p] += d.momentum[i];
+    d.inertiaTimesAcceleration[p] += d.inertiaTimesAcceleration[i];
+    d.wrench[p] += d.wrench[i];
+  }
+  for (int k = 1; k < nb; ++k) {
+    const Vector6& sk = d.motion[k];
+    const Terms& t = d.terms[k];
+    d.alpha[k] = forceCross(sk, d.wrench[k] - d.inertiaTimesAcceleration[k]) - momentumCouplingTimes(t, sk);
+    d.beta[k] = -inertiaTimes(t, sk);
+    d.gamma[k] = velocityCouplingTimes(t, d.momentum[k].head<3>(), sk) + forceCross(sk, d.momentum[k]);
   }
 
   for (int pj = 1; pj < nb; ++pj) {
     const Vector6& sj = d.motion[pj];
     const Vector6& vj = d.twist[pj];
-    const Vector6& aj = d.acceleration[pj];
-    const Vector6& vParent = d.twist[edges[pj].parent];
-    const Vector6 sjCrossVj = motionCross(sj, vj);
-    const int end = model.subtreeEnd(pj);
-
-    // ∂/∂q_j. With c = S_j × V_j the products regroup as
-    //   ∂(I A) = S ×* (I A) + I ((V_i − V_j) × c − S × A_j),   ∂(I V) = S ×* (I V) − I c
-    // so each body costs two 6 × 6 products.
-    const Vector6 sjCrossAj = motionCross(sj, aj);
-    for (int i = pj; i < end; ++i) {
-      const Matrix6& I = d.inertia[i];
-      const Vector6& vi = d.twist[i];
-      const Vector6 dV = motionCross(sj, vi - vj);
-      const Vector6 dMomentum = forceCross(sj, d.momentum[i]) - I * sjCrossVj;
-      d.accumulated[i] = forceCross(sj, d.inertiaTimesAcceleration[i]) +
-                         I * (motionCross(vi - vj, sjCrossVj) - sjCrossAj) + forceCross(dV, d.momentum[i]) +
-                         forceCross(vi, dMomentum);
-    }
-    accumulateSubtree(model, d, pj);
-    scatterDirection<true>(model, d, pj, d.dtauDq, d.dwrenchDq);
-
-    // ∂/∂q̇_j
-    for (int i = pj; i < end; ++i) {
-      const Matrix6& I = d.inertia[i];
-      const Vector6& vi = d.twist[i];
-      const Vector6 dA = motionCross(sj, vi - vj - vParent);
-      d.accumulated[i] = I * dA + forceCross(sj, d.momentum[i]) + forceCross(vi, I * sj);
-    }
-    accumulateSubtree(model, d, pj);
-    scatterDirection<false>(model, d, pj, d.dtauDv, d.dwrenchDv);
-
-    // ∂/∂q̈_j: the mass matrix, CRBA-style. F = I^c_j S_j; M(a, j) = M(j, a) = S_a · F for
-    // j and each joint a between j and the reference body; W0 takes F.
-    const Vector6 force = d.compositeInertia[pj] * sj;
+    const Terms& t = d.terms[pj];
+    const Vector3 linearMomentum = d.momentum[pj].head<3>();
+    const Vector6 cj = motionCross(sj, vj);
+    const Vector6 uj = motionCross(sj, d.acceleration[pj]) + motionCross(vj, cj);
+    const Vector6 ej = motionCross(sj, vj + d.twist[edges[pj].parent]);
     const int column = edges[pj].joint;
-    for (int p = pj; p > 0; p = edges[p].parent) {
-      const double value = d.motion[p].dot(force);
-      d.dtauDa(edges[p].joint, column) = value;
-      d.dtauDa(column, edges[p].joint) = value;
+    // The subtree of j: three dot products a joint.
+    for (int k = pj; k < model.subtreeEnd(pj); ++k) {
+      const int row = edges[k].joint;
+      d.dtauDq(row, column) = sj.dot(d.alpha[k]) + uj.dot(d.beta[k]) + cj.dot(d.gamma[k]);
+      d.dtauDv(row, column) = ej.dot(d.beta[k]) - sj.dot(d.gamma[k]);
     }
-    d.dwrenchDa.col(column) = force;
+    // Between j and the reference body: S_a · G_j, and W0 takes G_j.
+    const Vector6 gq = forceCross(sj, d.inertiaTimesAcceleration[pj]) - inertiaTimes(t, uj) +
+                       velocityCouplingTimes(t, linearMomentum, cj) + momentumCouplingTimes(t, sj) -
+                       forceCross(cj, d.momentum[pj]);
+    const Vector6 gv =
+        forceCross(sj, d.momentum[pj]) - velocityCouplingTimes(t, linearMomentum, sj) - inertiaTimes(t, ej);
+    // ∂/∂q̈_j: the mass matrix, CRBA-style: F = Iᶜ_j S_j, M(a, j) = M(j, a) = S_a · F.
+    const Vector6 ga = -d.beta[pj];
+    for (int p = edges[pj].parent; p > 0; p = edges[p].parent) {
+      const int row = edges[p].joint;
+      d.dtauDq(row, column) = d.motion[p].dot(gq);
+      d.dtauDv(row, column) = d.motion[p].dot(gv);
+      const double mass = d.motion[p].dot(ga);
+      d.dtauDa(row, column) = mass;
+      d.dtauDa(column, row) = mass;
+    }
+    d.dtauDa(column, column) = sj.dot(ga);
+    d.dwrenchDq.col(column) = gq;
+    d.dwrenchDv.col(column) = gv;
+    d.dwrenchDa.col(column) = ga;
   }
 }
 

@@ -8,9 +8,27 @@
 //   ∂V_i/∂q_j = S_j × (V_i − V_j)
 //   ∂A_i/∂q_j = S_j × (A_i − A_j) + (V_i − V_j) × (S_j × V_j)
 //   ∂V_i/∂q̇_j = S_j,    ∂A_i/∂q̇_j = S_j × (V_i − V_j − V_λ(j)),    ∂A_i/∂q̈_j = S_j
-// for bodies i in the subtree of j (and zero elsewhere). Body wrenches F_i = I_i A_i +
-// V_i ×* I_i V_i are differentiated directly, accumulated over j's subtree, and
-// Γ_i = S_i · F^c_i gives ∂Γ; W0 = F^c_root. One sample costs O(joints × depth).
+// for bodies i in the subtree of j (and zero elsewhere). Differentiating the body wrenches
+// F_i = I_i A_i + V_i ×* I_i V_i and summing over a subtree, every term is bilinear in a
+// quantity of j and one of the bodies: with the per-body matrices
+//   Y_i = I_i crm(V_i) − crf(V_i) I_i,     Z_i = crf(V_i) B(h_i) − B(h_i) crm(V_i)
+// (h_i = I_i V_i, B(h) x = x ×* h) and their subtree sums (ᶜ), each joint k in the subtree
+// of j gets, with c_j = S_j × V_j, u_j = S_j × A_j + V_j × c_j, e_j = S_j × (V_j + V_λ(j)):
+//   ∂Γ_k/∂q_j = S_j·α_k + u_j·β_k + c_j·γ_k,     ∂Γ_k/∂q̇_j = −S_j·γ_k + e_j·β_k
+//   α_k = Zᶜ_kᵀ S_k + S_k ×* (Fᶜ_k − Pᶜ_k),  β_k = −Iᶜ_k S_k,  γ_k = Yᶜ_kᵀ S_k + S_k ×* Hᶜ_k
+// (P = I A, H = h; the identity b·(a ×* f) = −a·(b ×* f) moves S_k to the other side), and
+// the joints between j and the reference body get S_a · Gⱼ with Gⱼ the subtree sum at j:
+//   G_j^q = S_j ×* Pᶜ_j − Iᶜ_j u_j + Yᶜ_j c_j + Zᶜ_j S_j − c_j ×* Hᶜ_j = ∂W0/∂q_j
+//   G_j^v = −Yᶜ_j S_j + S_j ×* Hᶜ_j − Iᶜ_j e_j = ∂W0/∂q̇_j
+// ∂Γ/∂q̈ is the mass matrix (CRBA). Per sample: O(bodies) work, then three dot products per
+// (joint, descendant) pair — the organisation of Carpentier & Mansard's analytical RNEA
+// derivatives (RSS 2018), derived here for the rooted world-frame recursion.
+//
+// No 6 × 6 matrix is formed. In 3 × 3 blocks, with V = (v, ω), h = (f, n) = I V:
+//   I = [[m, −[mc]×], [[mc]×, J]]              (J: rotational inertia about the origin)
+//   Y = [[0, [f]×], [−[f]×, E]],  E = v (mc)ᵀ + mc vᵀ − 2 (mc·v) 1 + J[ω]× + (J[ω]×)ᵀ   (Y = Yᵀ)
+//   Z = [[0, [z₁]×], [[z₁]×, [z₂]×]],  z₁ = f × ω,  z₂ = f × v + n × ω                  (Z = −Zᵀ)
+// and subtree sums add the block parameters (m, mc, J, f, E, z₁, z₂).
 
 #include <Eigen/Core>
 #include <vector>
@@ -28,9 +46,18 @@ struct DynamicsDerivatives {
   Eigen::Matrix<double, 6, Eigen::Dynamic> dwrenchDq, dwrenchDv, dwrenchDa;  ///< W0 at the world origin, 6 × jointCount
 
   // Workspace, by tree position.
-  std::vector<Matrix6> inertia;           ///< world spatial inertia of each body
-  std::vector<Matrix6> compositeInertia;  ///< summed over the subtree
-  std::vector<Vector6> motion, twist, acceleration, momentum, inertiaTimesAcceleration, compositeWrench, accumulated;
+  /// Block parameters of I, Y and Z (see above) of each body, then of its subtree.
+  struct BodyTerms {
+    double mass = 0.0;
+    Vector3 massCom = Vector3::Zero();        ///< m c
+    Matrix3 rotational = Matrix3::Zero();     ///< J about the world origin
+    Matrix3 velocityBlock = Matrix3::Zero();  ///< E of Y
+    Vector3 z1 = Vector3::Zero(), z2 = Vector3::Zero();
+  };
+  std::vector<BodyTerms> terms;
+  std::vector<Vector6> motion, twist, acceleration;   ///< S_i, V_i, A_i
+  std::vector<Vector6> momentum, inertiaTimesAcceleration, wrench;  ///< h_i, P_i, F_i, then their subtree sums
+  std::vector<Vector6> alpha, beta, gamma;       ///< per joint k (by position), see above
 };
 
 /// Runs inverseDynamics (filling `data`) and its derivatives (filling `derivatives`).

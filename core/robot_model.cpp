@@ -94,7 +94,7 @@ RigidTransform toTransform(const urdf::Pose& pose) {
 
 // Below this excess over the triangle inequality an inertia slip changes no humanoid
 // torque measurably (1e-5 kg m² ≈ 0.1 kg at 1 cm): published CAD exports round small
-// parts (Talos' gripper motor, 5.7e-6) and placeholders carry token values (iCub).
+// parts (Talos' gripper motor, 5.7e-6) and stand-in links carry token values (iCub).
 constexpr double kNegligibleInertiaExcess = 1e-5;  // kg m²
 
 BodyInertia readInertia(const urdf::Link& link, const std::string& source, const UrdfOptions& options,
