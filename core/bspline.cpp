@@ -160,4 +160,35 @@ void SampledTrajectory::evaluate(int sample, const Eigen::MatrixXd& points, doub
   a /= duration * duration;
 }
 
+void SampledTrajectory::chainRule(int sample, double duration, const Eigen::Ref<const Eigen::MatrixXd>& dyDq,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& dyDv,
+                                  const Eigen::Ref<const Eigen::MatrixXd>& dyDa, Eigen::MatrixXd& dyDx,
+                                  Eigen::VectorXi& parameters) const {
+  const LocalParameterWeights& w = weights_[sample];
+  const int n = parametrization_.jointCount(), m = parametrization_.parametersPerJoint(), k = w.count;
+  const Eigen::Index rows = std::max({dyDq.rows(), dyDv.rows(), dyDa.rows()});
+  dyDx.resize(rows, n * k);
+  parameters.resize(n * k);
+  const double t1 = 1.0 / duration, t2 = t1 * t1;
+  for (int j = 0; j < n; ++j)
+    for (int l = 0; l < k; ++l) {
+      const int c = j * k + l;
+      parameters[c] = j * m + w.parameter[l];
+      auto column = dyDx.col(c);
+      column.setZero();
+      if (dyDq.size() > 0) column.noalias() += w.value[l] * dyDq.col(j);
+      if (dyDv.size() > 0) column.noalias() += (w.d1[l] * t1) * dyDv.col(j);
+      if (dyDa.size() > 0) column.noalias() += (w.d2[l] * t2) * dyDa.col(j);
+    }
+}
+
+void SampledTrajectory::durationDerivative(double duration, const Eigen::Ref<const Eigen::MatrixXd>& dyDv,
+                                           const Eigen::Ref<const Eigen::MatrixXd>& dyDa,
+                                           const Eigen::Ref<const Eigen::VectorXd>& v,
+                                           const Eigen::Ref<const Eigen::VectorXd>& a, Eigen::VectorXd& dyDT) {
+  dyDT.noalias() = dyDv * v;
+  dyDT.noalias() += 2.0 * dyDa * a;
+  dyDT /= -duration;
+}
+
 }  // namespace mcopt

@@ -85,6 +85,19 @@ class SampledTrajectory {
   const LocalBasis& basis(int sample) const { return bases_[sample]; }
   const LocalParameterWeights& weights(int sample) const { return weights_[sample]; }
 
+  /// Chain rule through the splines for any per-sample output y(q, q̇, q̈) (rows m):
+  ///   ∂y/∂x_{j,l} = ∂y/∂q_j w_l + ∂y/∂q̇_j w'_l / T + ∂y/∂q̈_j w''_l / T²
+  /// over the k ≤ 4 local parameters of every joint. dyDx: m × (jointCount · k), written;
+  /// parameters: jointCount · k global indices, written. Either input may be empty (zero).
+  void chainRule(int sample, double duration, const Eigen::Ref<const Eigen::MatrixXd>& dyDq,
+                 const Eigen::Ref<const Eigen::MatrixXd>& dyDv, const Eigen::Ref<const Eigen::MatrixXd>& dyDa,
+                 Eigen::MatrixXd& dyDx, Eigen::VectorXi& parameters) const;
+
+  /// ∂y/∂T = −(∂y/∂q̇ q̇ + 2 ∂y/∂q̈ q̈) / T (q fixed: it depends on t/T only). dyDT: m, written.
+  static void durationDerivative(double duration, const Eigen::Ref<const Eigen::MatrixXd>& dyDv,
+                                 const Eigen::Ref<const Eigen::MatrixXd>& dyDa, const Eigen::Ref<const Eigen::VectorXd>& v,
+                                 const Eigen::Ref<const Eigen::VectorXd>& a, Eigen::VectorXd& dyDT);
+
   /// q, v, a of every joint at one sample (jointCount each, written; no allocation).
   void evaluate(int sample, const Eigen::MatrixXd& controlPoints, double duration, Eigen::Ref<Eigen::VectorXd> q,
                 Eigen::Ref<Eigen::VectorXd> v, Eigen::Ref<Eigen::VectorXd> a) const;

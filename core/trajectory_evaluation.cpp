@@ -16,6 +16,21 @@ double positiveEnergy(const Eigen::MatrixXd& power, const Eigen::VectorXd& time)
   return energy;
 }
 
+void prepareTrajectoryResult(const SampledTrajectory& samples, int n, const Eigen::Ref<const Eigen::VectorXd>& parameters,
+                             double duration, TrajectoryResult& r) {
+  const auto& parametrization = samples.parametrization();
+  if (parameters.size() != parametrization.parameterCount())
+    throw InputError("expected " + std::to_string(parametrization.parameterCount()) + " spline parameters, got " +
+                     std::to_string(parameters.size()));
+  if (!(duration > 0.0) || !std::isfinite(duration))
+    throw InputError("duration must be positive and finite, got " + std::to_string(duration));
+  if (!parameters.allFinite()) throw InputError("spline parameters contain NaN or infinity");
+  const int count = samples.sampleCount();
+  r.time.resize(count);
+  for (Eigen::MatrixXd* m : {&r.q, &r.v, &r.a, &r.tau, &r.power}) m->resize(n, count);
+  r.referenceWrench.resize(6, count);
+}
+
 TrajectoryEvaluator::TrajectoryEvaluator(const DynamicsModel& model, ActuatorSet actuators, SampledTrajectory samples)
     : model_(model), actuators_(std::move(actuators)), samples_(std::move(samples)) {
   if (static_cast<int>(actuators_.joints.size()) != model.jointCount())
@@ -29,22 +44,9 @@ TrajectoryEvaluator::TrajectoryEvaluator(const DynamicsModel& model, ActuatorSet
 
 void TrajectoryEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
                                    TrajectoryResult& r) {
-  const auto& parametrization = samples_.parametrization();
-  if (parameters.size() != parametrization.parameterCount())
-    throw InputError("expected " + std::to_string(parametrization.parameterCount()) + " spline parameters, got " +
-                     std::to_string(parameters.size()));
-  if (!(duration > 0.0) || !std::isfinite(duration))
-    throw InputError("duration must be positive and finite, got " + std::to_string(duration));
-  if (!parameters.allFinite()) throw InputError("spline parameters contain NaN or infinity");
   const int n = model_.jointCount(), count = samples_.sampleCount();
-  r.time.resize(count);
-  r.q.resize(n, count);
-  r.v.resize(n, count);
-  r.a.resize(n, count);
-  r.tau.resize(n, count);
-  r.power.resize(n, count);
-  r.referenceWrench.resize(6, count);
-  parametrization.controlPoints(parameters, controlPoints_);
+  prepareTrajectoryResult(samples_, n, parameters, duration, r);
+  samples_.parametrization().controlPoints(parameters, controlPoints_);
 
 #pragma omp parallel for schedule(static)
   for (int s = 0; s < count; ++s) {

@@ -22,6 +22,12 @@ struct TrajectoryResult {
   double energy = 0.0;                             ///< ∫ Σ_j max(P_j, 0) dt, trapezoid rule [J]
 };
 
+/// Checks parameters (count, finiteness) and duration, then sizes `result` for the samples
+/// (no allocation once sized). Throws InputError naming what is wrong.
+void prepareTrajectoryResult(const SampledTrajectory& samples, int jointCount,
+                             const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
+                             TrajectoryResult& result);
+
 /// ∫ Σ_j max(P_j, 0) dt by the trapezoid rule over the sample times (formulation.md §6).
 double positiveEnergy(const Eigen::MatrixXd& power, const Eigen::VectorXd& time);
 

@@ -24,12 +24,7 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
                                            TrajectoryResult& r, TrajectoryGradient& g) {
   const auto& parametrization = samples_.parametrization();
   const int n = model_.jointCount(), count = samples_.sampleCount(), m = parametrization.parametersPerJoint();
-  if (parameters.size() != parametrization.parameterCount() || !parameters.allFinite())
-    throw InputError("expected " + std::to_string(parametrization.parameterCount()) + " finite spline parameters");
-  if (!(duration > 0.0) || !std::isfinite(duration)) throw InputError("duration must be positive and finite");
-  r.time.resize(count);
-  for (Eigen::MatrixXd* x : {&r.q, &r.v, &r.a, &r.tau, &r.power}) x->resize(n, count);
-  r.referenceWrench.resize(6, count);
+  prepareTrajectoryResult(samples_, n, parameters, duration, r);
   g.torque.resize(static_cast<std::size_t>(count));
   parametrization.controlPoints(parameters, controlPoints_);
   for (ThreadWorkspace& w : workspaces_) {
@@ -48,22 +43,12 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
     r.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
     const DynamicsDerivatives& d = w.derivatives;
 
-    // Torque Jacobian block over the local parameters.
+    // Torque Jacobian block over the local parameters, and w.r.t. T.
     const LocalParameterWeights& weights = samples_.weights(s);
     const int k = weights.count;
     SampleTorqueJacobian& block = g.torque[static_cast<std::size_t>(s)];
-    block.parameters.resize(n * k);
-    block.dtauDx.resize(n, n * k);
-    for (int j = 0; j < n; ++j)
-      for (int l = 0; l < k; ++l) {
-        block.parameters[j * k + l] = j * m + weights.parameter[l];
-        block.dtauDx.col(j * k + l).noalias() = weights.value[l] * d.dtauDq.col(j);
-        block.dtauDx.col(j * k + l).noalias() += (weights.d1[l] / duration) * d.dtauDv.col(j);
-        block.dtauDx.col(j * k + l).noalias() += (weights.d2[l] / (duration * duration)) * d.dtauDa.col(j);
-      }
-    block.dtauDT.noalias() = d.dtauDv * r.v.col(s);
-    block.dtauDT.noalias() += 2.0 * d.dtauDa * r.a.col(s);
-    block.dtauDT /= -duration;
+    samples_.chainRule(s, duration, d.dtauDq, d.dtauDv, d.dtauDa, block.dtauDx, block.parameters);
+    SampledTrajectory::durationDerivative(duration, d.dtauDv, d.dtauDa, r.v.col(s), r.a.col(s), block.dtauDT);
 
     // Energy: trapezoid weight c_s Δt on Σ_j max(P, 0).
     const double weight = (s == 0 || s == count - 1) ? 0.5 * dt : dt;

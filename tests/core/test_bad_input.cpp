@@ -8,6 +8,7 @@
 #include "core/dynamics_model.hpp"
 #include "core/errors.hpp"
 #include "core/robot_files.hpp"
+#include "core/trajectory_evaluation.hpp"
 
 using namespace mcopt;
 using Catch::Matchers::Contains;
@@ -162,4 +163,21 @@ TEST_CASE("actuator, contact and posture files: errors name file, line and field
     const auto file = dir.write("p.yaml", "postures:\n  up: {shoulder: 0.5}\n  bad: {knee: 1}\n");
     CHECK_THROWS_WITH(loadPostures(file, model), Contains("p.yaml:3") && Contains("postures.bad.knee") && Contains("unknown joint"));
   }
+}
+
+TEST_CASE("trajectory evaluation refuses NaN parameters and impossible durations", "[input][spline]") {
+  const RobotModel model = loadUrdfString(kGood, "good.urdf");
+  const DynamicsModel dynamics(model, "base");
+  const MotionParametrization parametrization(model.jointCount());
+  TrajectoryEvaluator evaluator(dynamics, defaultActuators(model), SampledTrajectory(parametrization, 10));
+  TrajectoryResult result;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(parametrization.parameterCount());
+  CHECK_NOTHROW(evaluator.evaluate(x, 1.0, result));
+  CHECK_THROWS_WITH(evaluator.evaluate(x, 0.0, result), Contains("duration must be positive"));
+  CHECK_THROWS_WITH(evaluator.evaluate(x, std::nan(""), result), Contains("duration"));
+  CHECK_THROWS_WITH(evaluator.evaluate(Eigen::VectorXd::Zero(3), 1.0, result), Contains("expected 10 spline parameters, got 3"));
+  x[4] = std::nan("");
+  CHECK_THROWS_WITH(evaluator.evaluate(x, 1.0, result), Contains("NaN"));
+  CHECK_THROWS_WITH(MotionParametrization(3, 5), Contains("at least 7 control points"));
+  CHECK_THROWS_WITH(SampledTrajectory(parametrization, 1), Contains("at least 2 samples"));
 }

@@ -4,6 +4,7 @@
 
 #include "common/robots.hpp"
 #include "core/contact_maps.hpp"
+#include "core/dynamics_derivatives.hpp"
 #include "core/kinematics.hpp"
 #include "core/motion_derivatives.hpp"
 #include "core/robot_files.hpp"
@@ -218,6 +219,86 @@ TEST_CASE("body twist and acceleration derivatives match central differences", "
       else if (input == &v) analytic << dVv, dAv;
       else analytic << Eigen::MatrixXd::Zero(6, n), dAa;
       INFO(named.name << (input == &q ? " q" : input == &v ? " v" : " a"));
+      CHECK(test::scaledError(analytic, fd) <= 1e-6);
+    }
+  }
+}
+
+TEST_CASE("frame Jacobians are the derivatives of frame poses", "[derivatives][kinematics]") {
+  std::mt19937 rng(47);
+  for (const auto& named : test::allRobots()) {
+    const RobotModel robot = test::load(named);
+    const DynamicsModel model(robot, named.soles[0]);
+    DynamicsData data(model);
+    const int frame = robot.frameIndex(named.soles[1]);
+    Eigen::VectorXd q, v, a;
+    test::randomState(rng, robot, q, v, a);
+    forwardKinematics(model, data, q);
+    const RigidTransform pose = framePose(model, data, frame);
+    FrameJacobian jacobian;
+    frameJacobian(model, data, model.framePosition(frame), pose.translation, jacobian);
+    const double h = 1e-6;
+    FrameJacobian fd(6, robot.jointCount());
+    for (int k = 0; k < robot.jointCount(); ++k) {
+      RigidTransform side[2];
+      for (int s = 0; s < 2; ++s) {
+        Eigen::VectorXd qs = q;
+        qs[k] += s == 0 ? h : -h;
+        forwardKinematics(model, data, qs);
+        side[s] = framePose(model, data, frame);
+      }
+      fd.col(k).head<3>() = (side[0].translation - side[1].translation) / (2 * h);
+      // Angular velocity from the rotation difference: R₊ R₋ᵀ ≈ 1 + 2h [ω]×.
+      const Matrix3 delta = side[0].rotation * side[1].rotation.transpose();
+      fd.col(k).tail<3>() = Vector3(delta(2, 1) - delta(1, 2), delta(0, 2) - delta(2, 0), delta(1, 0) - delta(0, 1)) / (4 * h);
+    }
+    INFO(named.name);
+    CHECK(test::scaledError(jacobian, fd) <= 1e-6);
+  }
+}
+
+TEST_CASE("the reference wrench through the splines: chain rule against differences", "[derivatives][spline]") {
+  std::mt19937 rng(53);
+  const auto named = test::hrp2();
+  const RobotModel robot = test::load(named);
+  const DynamicsModel model(robot, "l_sole");
+  DynamicsData data(model);
+  DynamicsDerivatives derivatives(model);
+  const MotionParametrization parametrization(robot.jointCount());
+  const SampledTrajectory samples(parametrization, 9);
+  TrajectoryEvaluator plain(model, defaultActuators(robot), samples);
+  Eigen::VectorXd x = test::randomVector(rng, parametrization.parameterCount(), 0.4);
+  const double T = 0.9, h = 1e-6;
+  Eigen::MatrixXd points;
+  parametrization.controlPoints(x, points);
+  Eigen::VectorXd q(30), v(30), a(30);
+  std::vector<Eigen::MatrixXd> blocks;
+  std::vector<Eigen::VectorXi> columns;
+  for (int s = 0; s < samples.sampleCount(); ++s) {
+    samples.evaluate(s, points, T, q, v, a);
+    inverseDynamicsDerivatives(model, data, derivatives, q, v, a);
+    Eigen::Matrix<double, 6, Eigen::Dynamic> dq, dv, da;
+    wrenchDerivativeAtReferenceFrame(model, derivatives.dwrenchDq, dq);
+    wrenchDerivativeAtReferenceFrame(model, derivatives.dwrenchDv, dv);
+    wrenchDerivativeAtReferenceFrame(model, derivatives.dwrenchDa, da);
+    blocks.emplace_back();
+    columns.emplace_back();
+    samples.chainRule(s, T, dq, dv, da, blocks.back(), columns.back());
+  }
+  TrajectoryResult plus, minus;
+  for (int p = 0; p < parametrization.parameterCount(); ++p) {
+    const double saved = x[p];
+    x[p] = saved + h;
+    plain.evaluate(x, T, plus);
+    x[p] = saved - h;
+    plain.evaluate(x, T, minus);
+    x[p] = saved;
+    for (int s = 0; s < samples.sampleCount(); ++s) {
+      Vector6 analytic = Vector6::Zero();
+      for (Eigen::Index c = 0; c < columns[s].size(); ++c)
+        if (columns[s][c] == p) analytic += blocks[s].col(c);
+      const Vector6 fd = (plus.referenceWrench.col(s) - minus.referenceWrench.col(s)) / (2 * h);
+      INFO("parameter " << p << " sample " << s);
       CHECK(test::scaledError(analytic, fd) <= 1e-6);
     }
   }
