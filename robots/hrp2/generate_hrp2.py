@@ -182,6 +182,12 @@ def table():
         rows.append(f"| {label} | {value} m | {method} |")
     for name, (m, size, com) in LINKS.items():
         rows.append(f"| {name}: mass / box / com | {m} kg / {fmt(size)} m / {fmt(com)} m | {EST_MASS}; inertia: {EST_BOX} |")
+    frame_methods = {"r_sole": FACT + " (0.105 m below the ankle)", "l_sole": FACT + " (0.105 m below the ankle)",
+                     "r_palm": "estimate: below the closed gripper (hand box 0.12 m + finger 0.04 m)",
+                     "l_palm": "estimate: below the closed gripper (hand box 0.12 m + finger 0.04 m)",
+                     "head_top": "top of the head box: closes the published height"}
+    for name, parent, origin in FRAMES:
+        rows.append(f"| frame {name} on {parent} | {fmt(origin)} m | {frame_methods[name]} |")
     rows.append("| effort and velocity limits (URDF defaults) | per joint class | estimate, see actuators.yaml |")
     return "\n".join(rows) + "\n"
 
