@@ -20,13 +20,15 @@ ContactFrame contactFrame(const DynamicsModel& model, const DynamicsData& data, 
   return {model.framePosition(frame), framePose(model, data, frame) * placement};
 }
 
-void wrenchToWorld(const ContactFrame& contact, Matrix6& toWorld) {
-  const Matrix3& R = contact.contactPose.rotation;
+void wrenchToWorld(const RigidTransform& contactPose, Eigen::Ref<Eigen::Matrix<double, 6, 6>> toWorld) {
+  const Matrix3& R = contactPose.rotation;
   toWorld.setZero();
   toWorld.topLeftCorner<3, 3>() = R;
-  toWorld.bottomLeftCorner<3, 3>() = skew(contact.contactPose.translation) * R;
+  toWorld.bottomLeftCorner<3, 3>() = skew(contactPose.translation) * R;
   toWorld.bottomRightCorner<3, 3>() = R;
 }
+
+void wrenchToWorld(const ContactFrame& contact, Matrix6& toWorld) { wrenchToWorld(contact.contactPose, toWorld); }
 
 void wrenchToTorque(const DynamicsModel& model, const DynamicsData& data, const ContactFrame& contact,
                     WrenchToTorque& toTorque) {

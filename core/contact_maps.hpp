@@ -28,6 +28,8 @@ ContactFrame contactFrame(const DynamicsModel& model, const DynamicsData& data, 
 
 /// wrenchToWorld: 6 × 6, written.
 void wrenchToWorld(const ContactFrame& contact, Matrix6& toWorld);
+/// The same for a contact frame given by its world pose alone.
+void wrenchToWorld(const RigidTransform& contactPose, Eigen::Ref<Eigen::Matrix<double, 6, 6>> toWorld);
 
 /// wrenchToTorque: jointCount × 6, written (structural zeros off the path).
 void wrenchToTorque(const DynamicsModel& model, const DynamicsData& data, const ContactFrame& contact,

@@ -1,0 +1,158 @@
+#include "inner_qp/contact_problem.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include "core/contact_maps.hpp"
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+namespace {
+
+// Wrench components within one contact's 6 columns.
+enum { Fx = 0, Fy, Fz, Mx, My, Mz };
+
+void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const Eigen::MatrixXd>& wrenchToTorque,
+              const Eigen::Ref<const Eigen::VectorXd>& tau0, const Vector6& balanceWrench,
+              const Eigen::Ref<const Eigen::VectorXd>& weights, const Eigen::Ref<const Eigen::VectorXd>& linear,
+              const ContactProblemSettings& settings) {
+  const auto nc = static_cast<Eigen::Index>(contacts.size());
+  const Eigen::Index n = tau0.size();
+  if (nc == 0) throw InputError("contacts: at least one contact is needed");
+  if (wrenchToTorque.rows() != n || wrenchToTorque.cols() != 6 * nc)
+    throw InputError("wrench_to_torque: expected " + std::to_string(n) + " × " + std::to_string(6 * nc) + ", got " +
+                     std::to_string(wrenchToTorque.rows()) + " × " + std::to_string(wrenchToTorque.cols()));
+  if (weights.size() != n || linear.size() != n)
+    throw InputError("torque_weights, torque_linear: expected " + std::to_string(n) + " values each");
+  if (!wrenchToTorque.allFinite() || !tau0.allFinite() || !balanceWrench.allFinite() || !weights.allFinite() ||
+      !linear.allFinite())
+    throw InputError("inner problem data contain NaN or infinity");
+  if ((weights.array() <= 0.0).any()) throw InputError("torque_weights: must all be positive");
+  if (settings.model == ContactModel::Pyramid && settings.pyramidFacets < 3)
+    throw InputError("pyramid facets: need at least 3, got " + std::to_string(settings.pyramidFacets));
+  if (!(settings.tikhonov >= 0.0)) throw InputError("tikhonov: must be non-negative");
+  for (const ContactSpec& c : contacts) {
+    const std::string where = "contact '" + c.name + "': ";
+    if (!(c.friction > 0.0) || !std::isfinite(c.friction)) throw InputError(where + "mu must be positive");
+    if (!(c.xMin < c.xMax && c.yMin < c.yMax))
+      throw InputError(where + "rectangle must be [x_min, x_max, y_min, y_max] with x_min < x_max, y_min < y_max");
+    if (!(c.minNormalForce >= 0.0)) throw InputError(where + "minimum normal force must be non-negative");
+    if (!c.pose.rotation.allFinite() || !c.pose.translation.allFinite())
+      throw InputError(where + "pose is not finite");
+  }
+}
+
+/// Appends one row a·F_contact ≤ bound over the contact's 6 columns.
+struct RowWriter {
+  Eigen::MatrixXd& rows;
+  Eigen::VectorXd& bounds;
+  Eigen::Index next = 0;
+  void add(int contact, std::initializer_list<std::pair<int, double>> terms, double bound = 0.0) {
+    rows.row(next).setZero();
+    for (const auto& [component, value] : terms) rows(next, 6 * contact + component) += value;
+    bounds[next] = bound;
+    ++next;
+  }
+};
+
+int rowsPerContact(const ContactProblemSettings& s) {
+  switch (s.model) {
+    case ContactModel::Report: return 5;                        // fz ≥ f_min, 4 CoP rows
+    case ContactModel::Pyramid: return 5 + s.pyramidFacets;      // + facets
+    case ContactModel::WrenchCone: return 5 + 4 + 8;             // + |fx|,|fy| ≤ μ fz, 8 yaw rows
+  }
+  return 0;
+}
+
+}  // namespace
+
+ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
+                                      const Eigen::Ref<const Eigen::MatrixXd>& J1,
+                                      const Eigen::Ref<const Eigen::VectorXd>& tau0, const Vector6& balanceWrench,
+                                      const Eigen::Ref<const Eigen::VectorXd>& weights,
+                                      const Eigen::Ref<const Eigen::VectorXd>& linear,
+                                      const ContactProblemSettings& settings) {
+  validate(contacts, J1, tau0, balanceWrench, weights, linear, settings);
+  ContactProblem p;
+  const int nc = static_cast<int>(contacts.size());
+  p.contactCount = nc;
+  p.tikhonov = settings.tikhonov;
+  // Objective (§7): Σ w Γ² + l Γ with Γ = τ0 − J1 F.
+  const Eigen::MatrixXd weighted = weights.asDiagonal() * J1;
+  p.hessian = 2.0 * J1.transpose() * weighted;
+  p.hessian.diagonal().array() += settings.tikhonov;
+  p.gradient = -(J1.transpose() * (2.0 * weights.cwiseProduct(tau0) + linear));
+  p.constant = (weights.cwiseProduct(tau0.cwiseProduct(tau0)) + linear.cwiseProduct(tau0)).sum();
+
+  // Balance (§5): the contact wrenches moved to the world origin add up to W.
+  p.balance.resize(6, 6 * nc);
+  for (int i = 0; i < nc; ++i) wrenchToWorld(contacts[i].pose, p.balance.middleCols<6>(6 * i));
+  p.balanceTarget = balanceWrench;
+
+  const int perContact = rowsPerContact(settings);
+  p.inequality.resize(perContact * nc, 6 * nc);
+  p.inequalityBound.resize(perContact * nc);
+  RowWriter rows{p.inequality, p.inequalityBound};
+  for (int i = 0; i < nc; ++i) {
+    const ContactSpec& c = contacts[i];
+    const double mu = c.friction;
+    rows.add(i, {{Fz, -1.0}}, -c.minNormalForce);       // fz ≥ f_min
+    rows.add(i, {{My, -1.0}, {Fz, -c.xMax}});            // −m_y ≤ x_max fz
+    rows.add(i, {{My, 1.0}, {Fz, c.xMin}});              // x_min fz ≤ −m_y
+    rows.add(i, {{Mx, 1.0}, {Fz, -c.yMax}});             // m_x ≤ y_max fz
+    rows.add(i, {{Mx, -1.0}, {Fz, c.yMin}});             // y_min fz ≤ m_x
+    switch (settings.model) {
+      case ContactModel::Report:
+        p.cones.push_back({6 * i, mu});
+        break;
+      case ContactModel::Pyramid: {
+        const int k = settings.pyramidFacets;
+        const double inscribed = mu * std::cos(std::numbers::pi / k);
+        for (int f = 0; f < k; ++f) {
+          const double theta = 2.0 * std::numbers::pi * f / k;
+          rows.add(i, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
+        }
+        break;
+      }
+      case ContactModel::WrenchCone: {
+        // About the rectangle's centre (cx, cy): m'_x = m_x − cy fz, m'_y = m_y + cx fz,
+        // m'_z = m_z − cx fy + cy fx.
+        const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
+        const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
+        rows.add(i, {{Fx, 1.0}, {Fz, -mu}});
+        rows.add(i, {{Fx, -1.0}, {Fz, -mu}});
+        rows.add(i, {{Fy, 1.0}, {Fz, -mu}});
+        rows.add(i, {{Fy, -1.0}, {Fz, -mu}});
+        for (double s1 : {-1.0, 1.0})
+          for (double s2 : {-1.0, 1.0}) {
+            // m'_z ≤ μ(X+Y) fz − s1 (Y fx + μ m'_x) − s2 (X fy + μ m'_y)
+            rows.add(i, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
+                         {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, s1 * mu}, {Fz, -s1 * mu * cy},
+                         {Fy, s2 * X}, {My, s2 * mu}, {Fz, s2 * mu * cx}});
+            // −m'_z ≤ μ(X+Y) fz − s1 (Y fx − μ m'_x) − s2 (X fy − μ m'_y)
+            rows.add(i, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
+                         {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, -s1 * mu}, {Fz, s1 * mu * cy},
+                         {Fy, s2 * X}, {My, -s2 * mu}, {Fz, -s2 * mu * cx}});
+          }
+        break;
+      }
+    }
+  }
+  return p;
+}
+
+double ContactProblem::objective(const Eigen::Ref<const Eigen::VectorXd>& F) const {
+  const double regularised = 0.5 * F.dot(hessian * F) + gradient.dot(F) + constant;
+  return regularised - 0.5 * tikhonov * F.squaredNorm();
+}
+
+double ContactProblem::constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& F) const {
+  double worst = (balance * F - balanceTarget).cwiseAbs().maxCoeff();
+  if (inequality.rows() > 0) worst = std::max(worst, (inequality * F - inequalityBound).maxCoeff());
+  for (const FrictionCone& cone : cones)
+    worst = std::max(worst, std::hypot(F[cone.index], F[cone.index + 1]) - cone.friction * F[cone.index + 2]);
+  return std::max(worst, 0.0);
+}
+
+}  // namespace mcopt

@@ -1,0 +1,83 @@
+#pragma once
+// The inner problem of one time sample (formulation.md §5, §7): the contact wrenches
+// Fc = (F_1 … F_nc), each F_i = (f, m) in its own contact frame C_i, that minimise the
+// motors' power terms that depend on Fc,
+//     Σ_j w_j Γ_j² + l_j Γ_j,   Γ = τ0 − wrenchToTorque · Fc,
+// subject to the balance  wrenchToWorld · Fc = W  and, per contact, the constraints of the
+// chosen contact model. As a QP:  ½ Fcᵀ H Fc + cᵀ Fc (+ constant),
+//     H = 2 J1ᵀ diag(w) J1 + ε 1,   c = −J1ᵀ (2 diag(w) τ0 + l),
+// with the documented Tikhonov term ε (H is singular along wrench directions that move no
+// joint, e.g. every wrench on the reference body).
+//
+// Contact models, all in C_i with fz along the surface normal into the robot:
+//   report       fz ≥ f_min; fx² + fy² ≤ μ² fz² (a second-order cone, kept separate);
+//                centre of pressure in [x_min, x_max] × [y_min, y_max]:
+//                x_min fz ≤ −m_y ≤ x_max fz,  y_min fz ≤ m_x ≤ y_max fz      (2.21, with (2.20) corrected)
+//   pyramid      the cone replaced by k facets inscribed in it: cos θ_i fx + sin θ_i fy ≤ μ cos(π/k) fz
+//   wrench-cone  Caron, Pham, Nakamura (ICRA 2015) for the rectangle, taken about its centre:
+//                |fx|, |fy| ≤ μ fz; centre of pressure as above; and the yaw bounds
+//                −μ(X+Y) fz + |Y fx − μ m_x| + |X fy − μ m_y| ≤ m_z ≤ μ(X+Y) fz − |Y fx + μ m_x| − |X fy + μ m_y|
+//                (X, Y half-sizes), each absolute value expanded into linear rows.
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/spatial.hpp"
+
+namespace mcopt {
+
+enum class ContactModel { Report, Pyramid, WrenchCone };
+
+/// One contact of an inner problem: frame C in the world (z = normal into the robot),
+/// friction μ > 0, rectangle [xMin, xMax] × [yMin, yMax] in C.
+struct ContactSpec {
+  std::string name;
+  RigidTransform pose;
+  double friction = 0.7;
+  double xMin = 0, xMax = 0, yMin = 0, yMax = 0;
+  double minNormalForce = 0.0;  ///< f_min ≥ 0
+};
+
+struct ContactProblemSettings {
+  ContactModel model = ContactModel::Report;
+  int pyramidFacets = 8;    ///< k ≥ 3
+  double tikhonov = 1e-9;   ///< ε added to H's diagonal; not part of the reported objective
+};
+
+/// A second-order cone ‖(F[index], F[index + 1])‖ ≤ μ F[index + 2] (report model).
+struct FrictionCone {
+  int index = 0;
+  double friction = 0.0;
+};
+
+/// Problem data, sized once per contact set and overwritten per sample.
+struct ContactProblem {
+  int contactCount = 0;
+  Eigen::MatrixXd hessian;                           ///< H, 6nc × 6nc, with ε
+  Eigen::VectorXd gradient;                          ///< c, 6nc
+  double constant = 0.0;                             ///< Σ w τ0² + l τ0: objective at Fc = 0
+  double tikhonov = 0.0;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> balance;  ///< wrenchToWorld, 6 × 6nc
+  Vector6 balanceTarget = Vector6::Zero();           ///< W: world axes, about the world origin
+  Eigen::MatrixXd inequality;                        ///< G, rows × 6nc: G Fc ≤ bound
+  Eigen::VectorXd inequalityBound;
+  std::vector<FrictionCone> cones;                   ///< report model only
+
+  /// Σ w Γ² + l Γ at Fc, without the Tikhonov term (what results report).
+  double objective(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
+  /// Largest violation of the balance, the linear rows and the cones (0 when feasible).
+  double constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
+};
+
+/// Assembles the problem. wrenchToTorque: n × 6nc; tau0, torqueWeights (> 0), torqueLinear:
+/// n; balanceWrench: world axes about the world origin. Throws InputError naming the
+/// contact and field for sizes that disagree, μ ≤ 0, an empty rectangle or a non-finite value.
+ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
+                                      const Eigen::Ref<const Eigen::MatrixXd>& wrenchToTorque,
+                                      const Eigen::Ref<const Eigen::VectorXd>& tau0, const Vector6& balanceWrench,
+                                      const Eigen::Ref<const Eigen::VectorXd>& torqueWeights,
+                                      const Eigen::Ref<const Eigen::VectorXd>& torqueLinear,
+                                      const ContactProblemSettings& settings);
+
+}  // namespace mcopt
