@@ -1,0 +1,118 @@
+#pragma once
+// The inner problem as a plain NLP, shared by the third-party adapters (private header).
+// Variables x = Fc (6nc). Constraints, in order:
+//   6 balance equalities   wrenchToWorld F − W = 0          (unless the balance is dropped)
+//   linear inequalities    G F − h ≤ 0
+//   friction cones         fx² + fy² − μ² fz² ≤ 0          (report model), or with
+//                          coneSmoothing δ > 0 the inner smooth cone √(fx² + fy² + δ²) − μ fz ≤ 0,
+//                          whose fz-gradient never vanishes (constraint qualification holds at
+//                          an unloaded contact) and whose every point satisfies the true cone
+// Objective ½ Fᵀ H F + cᵀ F + constant of the given problem.
+
+#include <Eigen/Core>
+#include <cmath>
+#include <string>
+
+#include "inner_qp/inner_solver.hpp"
+
+namespace mcopt::inner_detail {
+
+class InnerNlp {
+ public:
+  InnerNlp(const ContactProblem& problem, bool withBalance, double coneSmoothing = 0.0)
+      : p_(problem), withBalance_(withBalance), delta_(coneSmoothing) {}
+
+  int variableCount() const { return 6 * p_.contactCount; }
+  int equalityCount() const { return withBalance_ ? 6 : 0; }
+  int inequalityCount() const { return static_cast<int>(p_.inequality.rows() + p_.cones.size()); }
+  const ContactProblem& problem() const { return p_; }
+
+  double objective(const double* x) const {
+    const auto F = wrenches(x);
+    return 0.5 * F.dot(p_.hessian * F) + p_.gradient.dot(F) + p_.constant;
+  }
+  void objectiveGradient(const double* x, double* out) const {
+    Eigen::Map<Eigen::VectorXd>(out, variableCount()) = p_.hessian * wrenches(x) + p_.gradient;
+  }
+  /// Equalities: value and dense row-major Jacobian (equalityCount × variableCount).
+  void equalities(const double* x, double* value, double* jacobian) const {
+    if (!withBalance_) return;
+    Eigen::Map<Vector6> out(value);
+    out = p_.balance * wrenches(x) - p_.balanceTarget;
+    if (jacobian)
+      Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic, Eigen::RowMajor>>(jacobian, 6, variableCount()) = p_.balance;
+  }
+  /// Inequalities g ≤ 0: value and dense row-major Jacobian (inequalityCount × variableCount).
+  void inequalities(const double* x, double* value, double* jacobian) const {
+    const auto F = wrenches(x);
+    const Eigen::Index rows = p_.inequality.rows();
+    Eigen::Map<Eigen::VectorXd> v(value, inequalityCount());
+    v.head(rows) = p_.inequality * F - p_.inequalityBound;
+    for (std::size_t k = 0; k < p_.cones.size(); ++k) {
+      const FrictionCone& c = p_.cones[k];
+      const double shear2 = F[c.index] * F[c.index] + F[c.index + 1] * F[c.index + 1];
+      v[rows + static_cast<Eigen::Index>(k)] =
+          delta_ > 0.0 ? std::sqrt(shear2 + delta_ * delta_) - c.friction * F[c.index + 2]
+                       : shear2 - c.friction * c.friction * F[c.index + 2] * F[c.index + 2];
+    }
+    if (jacobian) {
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, inequalityCount(),
+                                                                                            variableCount());
+      J.setZero();
+      J.topRows(rows) = p_.inequality;
+      for (std::size_t k = 0; k < p_.cones.size(); ++k) {
+        const FrictionCone& c = p_.cones[k];
+        const Eigen::Index r = rows + static_cast<Eigen::Index>(k);
+        if (delta_ > 0.0) {
+          const double norm = std::sqrt(F[c.index] * F[c.index] + F[c.index + 1] * F[c.index + 1] + delta_ * delta_);
+          J(r, c.index) = F[c.index] / norm;
+          J(r, c.index + 1) = F[c.index + 1] / norm;
+          J(r, c.index + 2) = -c.friction;
+        } else {
+          J(r, c.index) = 2.0 * F[c.index];
+          J(r, c.index + 1) = 2.0 * F[c.index + 1];
+          J(r, c.index + 2) = -2.0 * c.friction * c.friction * F[c.index + 2];
+        }
+      }
+    }
+  }
+  Eigen::Map<const Eigen::VectorXd> wrenches(const double* x) const { return {x, 6 * p_.contactCount}; }
+
+ private:
+  const ContactProblem& p_;
+  bool withBalance_;
+  double delta_;
+};
+
+/// Wrenches, objective and active set of a solution x of `problem`.
+void finishResult(const ContactProblem& problem, const double* x, InnerResult& result);
+
+/// Multipliers by least squares on the active set (for solvers that do not return them).
+void estimateMultipliers(const ContactProblem& problem, InnerResult& result);
+
+/// What one run of a third-party solver on an InnerNlp gives back.
+struct RunOutcome {
+  bool converged = false;
+  int iterations = 0;
+  std::string message;
+  bool hasMultipliers = false;
+  Vector6 equalityMultipliers = Vector6::Zero();
+  Eigen::VectorXd inequalityMultipliers;  ///< linear rows then cones, ≥ 0
+};
+
+/// x: starting point in, solution out (InnerNlp::variableCount()). Solver-specific choices
+/// (the cone form) are made by the runner from the problem it is given.
+using NlpRunner = RunOutcome (*)(const ContactProblem& problem, bool withBalance, const InnerSettings& settings,
+                                 Eigen::VectorXd& x);
+
+/// The common flow (formulation.md §7): solve; if that fails or leaves the balance violated,
+/// find the balance slack of least norm (min ‖wrenchToWorld F − W‖² under the contact
+/// constraints), solve again with the balance shifted by it, and report Infeasible with that
+/// slack when it is not zero. Fills the whole result.
+void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, NlpRunner run,
+                              InnerResult& result);
+
+/// Scale of the data for relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.
+double dataScale(const ContactProblem& problem);
+
+}  // namespace mcopt::inner_detail

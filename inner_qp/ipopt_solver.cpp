@@ -1,0 +1,161 @@
+// Ipopt on the inner problem: the report's slow baseline (formulation.md §7). Ipopt's
+// headers stay in this file. Exact Hessian of the Lagrangian: H plus,
+// per cone, its multiplier times diag(2, 2, −2μ²) on (fx, fy, fz) (the corrected (4.36)).
+#include <IpIpoptApplication.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
+
+#include "inner_qp/inner_nlp.hpp"
+
+namespace mcopt {
+
+namespace {
+
+using inner_detail::InnerNlp;
+using inner_detail::RunOutcome;
+using Ipopt::Index;
+using Ipopt::Number;
+
+class InnerTnlp final : public Ipopt::TNLP {
+ public:
+  InnerTnlp(const InnerNlp& nlp, Eigen::VectorXd& x, RunOutcome& outcome) : nlp_(nlp), x_(x), outcome_(outcome) {}
+
+  bool get_nlp_info(Index& n, Index& m, Index& nnzJacobian, Index& nnzHessian, IndexStyleEnum& style) override {
+    n = nlp_.variableCount();
+    m = nlp_.equalityCount() + nlp_.inequalityCount();
+    nnzJacobian = n * m;            // dense: the problem is tiny (6 nc ≤ 24 variables)
+    nnzHessian = n * (n + 1) / 2;   // lower triangle
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Index n, Number* xL, Number* xU, Index m, Number* gL, Number* gU) override {
+    for (Index i = 0; i < n; ++i) xL[i] = -2e19, xU[i] = 2e19;
+    for (Index i = 0; i < m; ++i) {
+      gL[i] = i < nlp_.equalityCount() ? 0.0 : -2e19;
+      gU[i] = 0.0;
+    }
+    return true;
+  }
+  bool get_starting_point(Index n, bool initX, Number* x, bool, Number*, Number*, Index, bool, Number*) override {
+    if (initX) std::copy(x_.data(), x_.data() + n, x);
+    return true;
+  }
+  bool eval_f(Index, const Number* x, bool, Number& value) override {
+    value = nlp_.objective(x);
+    return true;
+  }
+  bool eval_grad_f(Index, const Number* x, bool, Number* gradient) override {
+    nlp_.objectiveGradient(x, gradient);
+    return true;
+  }
+  bool eval_g(Index, const Number* x, bool, Index, Number* g) override {
+    nlp_.equalities(x, g, nullptr);
+    nlp_.inequalities(x, g + nlp_.equalityCount(), nullptr);
+    return true;
+  }
+  bool eval_jac_g(Index n, const Number* x, bool, Index m, Index, Index* rows, Index* cols, Number* values) override {
+    if (values == nullptr) {
+      for (Index r = 0; r < m; ++r)
+        for (Index c = 0; c < n; ++c) rows[r * n + c] = r, cols[r * n + c] = c;
+      return true;
+    }
+    const Index e = nlp_.equalityCount();
+    nlp_.equalities(x, scratch(static_cast<std::size_t>(e)), values);
+    nlp_.inequalities(x, scratch(static_cast<std::size_t>(m - e)), values + e * n);
+    return true;
+  }
+  bool eval_h(Index n, const Number*, bool, Number objectiveFactor, Index, const Number* lambda, bool, Index,
+              Index* rows, Index* cols, Number* values) override {
+    if (values == nullptr) {
+      Index k = 0;
+      for (Index r = 0; r < n; ++r)
+        for (Index c = 0; c <= r; ++c) rows[k] = r, cols[k] = c, ++k;
+      return true;
+    }
+    const ContactProblem& p = nlp_.problem();
+    Index k = 0;
+    for (Index r = 0; r < n; ++r)
+      for (Index c = 0; c <= r; ++c, ++k) values[k] = objectiveFactor * p.hessian(r, c);
+    const Index coneStart = nlp_.equalityCount() + static_cast<Index>(p.inequality.rows());
+    for (std::size_t i = 0; i < p.cones.size(); ++i) {
+      const FrictionCone& cone = p.cones[i];
+      const double nu = lambda[coneStart + static_cast<Index>(i)];
+      auto diagonal = [&](Index d) { return d * (d + 1) / 2 + d; };
+      values[diagonal(cone.index)] += 2.0 * nu;
+      values[diagonal(cone.index + 1)] += 2.0 * nu;
+      values[diagonal(cone.index + 2)] -= 2.0 * cone.friction * cone.friction * nu;
+    }
+    return true;
+  }
+  void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* x, const Number*, const Number*, Index m,
+                         const Number*, const Number* lambda, Number, const Ipopt::IpoptData*,
+                         Ipopt::IpoptCalculatedQuantities*) override {
+    x_ = Eigen::Map<const Eigen::VectorXd>(x, n);
+    // Ipopt's word is not final: it may declare local infeasibility at a feasible point. The
+    // common flow judges every finite point by feasibility and the KKT conditions.
+    outcome_.converged = status != Ipopt::INTERNAL_ERROR && status != Ipopt::INVALID_NUMBER_DETECTED;
+    outcome_.hasMultipliers = true;
+    const Index e = nlp_.equalityCount();
+    outcome_.equalityMultipliers.setZero();
+    for (Index i = 0; i < e; ++i) outcome_.equalityMultipliers[i] = lambda[i];
+    outcome_.inequalityMultipliers = Eigen::Map<const Eigen::VectorXd>(lambda + e, m - e);
+  }
+
+ private:
+  double* scratch(std::size_t size) {
+    buffer_.resize(size);
+    return buffer_.data();
+  }
+  const InnerNlp& nlp_;
+  Eigen::VectorXd& x_;
+  RunOutcome& outcome_;
+  std::vector<double> buffer_;
+};
+
+RunOutcome runIpopt(const ContactProblem& problem, bool withBalance, const InnerSettings& settings,
+                    Eigen::VectorXd& x) {
+  const InnerNlp nlp(problem, withBalance);  // the report's quadratic cone, as Ipopt solved it
+  RunOutcome outcome;
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->RethrowNonIpoptException(true);
+  app->Options()->SetIntegerValue("print_level", 0);
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetNumericValue("tol", settings.tolerance);
+  app->Options()->SetNumericValue("constr_viol_tol", settings.tolerance);
+  app->Options()->SetIntegerValue("max_iter", settings.maxIterations);
+  app->Options()->SetStringValue("mu_strategy", "adaptive");
+  // Feasibility is judged on the problem as given: no relaxed bounds, no internal scaling.
+  app->Options()->SetNumericValue("bound_relax_factor", 0.0);
+  app->Options()->SetStringValue("nlp_scaling_method", "none");
+  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+    outcome.message = "ipopt: initialisation failed";
+    return outcome;
+  }
+  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new InnerTnlp(nlp, x, outcome);
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
+  const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
+  outcome.iterations = Ipopt::IsValid(statistics) ? statistics->IterationCount() : 0;
+  outcome.message = "ipopt: return status " + std::to_string(static_cast<int>(status));
+  outcome.converged = outcome.converged && x.allFinite() && status > Ipopt::Internal_Error;
+  return outcome;
+}
+
+class IpoptSolver final : public InnerSolver {
+ public:
+  explicit IpoptSolver(const InnerSettings& settings) : settings_(settings) {}
+  std::string name() const override { return "ipopt"; }
+  void solve(const ContactProblem& problem, InnerResult& result) override {
+    inner_detail::solveWithElasticFallback(problem, settings_, runIpopt, result);
+  }
+
+ private:
+  InnerSettings settings_;
+};
+
+}  // namespace
+
+std::unique_ptr<InnerSolver> makeIpoptSolver(const InnerSettings& settings) {
+  return std::make_unique<IpoptSolver>(settings);
+}
+
+}  // namespace mcopt

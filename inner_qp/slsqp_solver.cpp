@@ -1,0 +1,97 @@
+// NLopt SLSQP on the inner problem (formulation.md §7). NLopt's headers stay in this file.
+// NLopt returns no multipliers: they are estimated by least squares on the active set, and
+// a stop on an x/f tolerance is re-checked against the constraints by the common flow.
+#include <nlopt.h>
+
+#include "inner_qp/inner_nlp.hpp"
+
+namespace mcopt {
+
+namespace {
+
+using inner_detail::InnerNlp;
+using inner_detail::RunOutcome;
+
+struct Counted {
+  const InnerNlp* nlp;
+  int evaluations = 0;
+};
+
+double objective(unsigned, const double* x, double* gradient, void* data) {
+  auto* c = static_cast<Counted*>(data);
+  ++c->evaluations;
+  if (gradient) c->nlp->objectiveGradient(x, gradient);
+  return c->nlp->objective(x);
+}
+
+void equalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
+  static_cast<Counted*>(data)->nlp->equalities(x, value, jacobian);
+}
+
+void inequalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
+  static_cast<Counted*>(data)->nlp->inequalities(x, value, jacobian);
+}
+
+RunOutcome runSlsqp(const ContactProblem& problem, bool withBalance, const InnerSettings& settings,
+                    Eigen::VectorXd& x) {
+  // The smooth inner cone keeps SLSQP's subproblems regular at unloaded contacts; δ is far
+  // below every tolerance of the result (1e-10 of the data's scale).
+  const InnerNlp nlp(problem, withBalance, 1e-10 * inner_detail::dataScale(problem));
+  const auto n = static_cast<unsigned>(nlp.variableCount());
+  nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
+  Counted counted{&nlp};
+  const double scale = inner_detail::dataScale(nlp.problem());
+  std::vector<double> equalityTolerance(6, 1e-3 * settings.tolerance * scale);
+  std::vector<double> inequalityTolerance(static_cast<std::size_t>(nlp.inequalityCount()), 1e-3 * settings.tolerance * scale);
+  nlopt_set_min_objective(opt, objective, &counted);
+  if (nlp.equalityCount() > 0) nlopt_add_equality_mconstraint(opt, 6, equalities, &counted, equalityTolerance.data());
+  if (nlp.inequalityCount() > 0)
+    nlopt_add_inequality_mconstraint(opt, static_cast<unsigned>(nlp.inequalityCount()), inequalities, &counted,
+                                     inequalityTolerance.data());
+  nlopt_set_xtol_rel(opt, 1e-14);
+  nlopt_set_ftol_rel(opt, 1e-16);
+  nlopt_set_maxeval(opt, settings.maxIterations);
+  // SLSQP may stop on its x tolerance a hair outside the constraints; a restart from its
+  // own point finishes the job (at most a few times).
+  RunOutcome out;
+  nlopt_result code = NLOPT_FAILURE;
+  for (int attempt = 0; attempt < 4; ++attempt) {
+    double value = 0.0;
+    code = nlopt_optimize(opt, x.data(), &value);
+    Eigen::VectorXd g(nlp.inequalityCount());
+    Vector6 e = Vector6::Zero();
+    if (nlp.inequalityCount() > 0) nlp.inequalities(x.data(), g.data(), nullptr);
+    nlp.equalities(x.data(), e.data(), nullptr);
+    const double violation = std::max(e.cwiseAbs().maxCoeff(), g.size() > 0 ? g.maxCoeff() : 0.0);
+    if (code == NLOPT_ROUNDOFF_LIMITED) continue;  // restart from where it stalled
+    if (code < 0 || !x.allFinite() || violation <= settings.tolerance * scale) break;
+  }
+  out.iterations = counted.evaluations;
+  // ROUNDOFF_LIMITED stops at a usable point more often than not: the common flow re-checks
+  // feasibility, so it counts as a stop, not a failure.
+  out.converged = (code > 0 || code == NLOPT_ROUNDOFF_LIMITED) && code != NLOPT_MAXEVAL_REACHED &&
+                  code != NLOPT_MAXTIME_REACHED && x.allFinite();
+  out.message = std::string("nlopt: ") + nlopt_result_to_string(code);
+  nlopt_destroy(opt);
+  return out;
+}
+
+class SlsqpSolver final : public InnerSolver {
+ public:
+  explicit SlsqpSolver(const InnerSettings& settings) : settings_(settings) {}
+  std::string name() const override { return "slsqp"; }
+  void solve(const ContactProblem& problem, InnerResult& result) override {
+    inner_detail::solveWithElasticFallback(problem, settings_, runSlsqp, result);
+  }
+
+ private:
+  InnerSettings settings_;
+};
+
+}  // namespace
+
+std::unique_ptr<InnerSolver> makeSlsqpSolver(const InnerSettings& settings) {
+  return std::make_unique<SlsqpSolver>(settings);
+}
+
+}  // namespace mcopt
