@@ -171,15 +171,19 @@ void SampledTrajectory::chainRule(int sample, double duration, const Eigen::Ref<
   parameters.resize(n * k);
   const double t1 = 1.0 / duration, t2 = t1 * t1;
   for (int j = 0; j < n; ++j)
-    for (int l = 0; l < k; ++l) {
-      const int c = j * k + l;
-      parameters[c] = j * m + w.parameter[l];
-      auto column = dyDx.col(c);
-      column.setZero();
-      if (dyDq.size() > 0) column.noalias() += w.value[l] * dyDq.col(j);
-      if (dyDv.size() > 0) column.noalias() += (w.d1[l] * t1) * dyDv.col(j);
-      if (dyDa.size() > 0) column.noalias() += (w.d2[l] * t2) * dyDa.col(j);
-    }
+    for (int l = 0; l < k; ++l) parameters[j * k + l] = j * m + w.parameter[l];
+  // The weights are shared by every joint: slot l of all joints is one whole-matrix
+  // expression over the columns l, l + k, l + 2k, … (a strided view), which vectorises.
+  using Strided = Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
+  for (int l = 0; l < k; ++l) {
+    Strided slot(dyDx.data() + l * rows, rows, n, Eigen::OuterStride<>(k * rows));
+    if (dyDq.size() > 0)
+      slot.noalias() = w.value[l] * dyDq;
+    else
+      slot.setZero();
+    if (dyDv.size() > 0) slot.noalias() += (w.d1[l] * t1) * dyDv;
+    if (dyDa.size() > 0) slot.noalias() += (w.d2[l] * t2) * dyDa;
+  }
 }
 
 void SampledTrajectory::durationDerivative(double duration, const Eigen::Ref<const Eigen::MatrixXd>& dyDv,
