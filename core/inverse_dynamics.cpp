@@ -33,7 +33,8 @@ inline void placeBody(const TreeJoint& edge, double qj, DynamicsData& d, int i) 
     jointOrigin.noalias() += d.rotation[p] * edge.before.translation;
     if (!edge.beforeIsTranslation) jointRotation = d.rotation[p] * edge.before.rotation;
   }
-  const Vector3 axis = jointRotation * edge.axis;
+  const Vector3 axis =
+      edge.axisIndex >= 0 ? Vector3(edge.axisSign * jointRotation.col(edge.axisIndex)) : Vector3(jointRotation * edge.axis);
   d.jointAxis[i] = axis;
   if (edge.prismatic) {
     jointOrigin += qj * axis;
