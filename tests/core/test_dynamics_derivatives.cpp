@@ -3,6 +3,7 @@
 // rooted at a sole so that reversed joints are exercised.
 #include <catch2/catch.hpp>
 
+#include "common/finite_differences.hpp"
 #include "common/robots.hpp"
 #include "core/dynamics_derivatives.hpp"
 
@@ -40,20 +41,16 @@ TEST_CASE("inverse dynamics derivatives match central differences", "[derivative
         const Outputs plain = evaluate(model, scratch, q, v, a);
         CHECK(test::scaledError(data.tau, plain.tau) <= 1e-12);
 
-        Eigen::MatrixXd fdTau(n, n);
-        Eigen::Matrix<double, 6, Eigen::Dynamic> fdWrench(6, n);
         for (Eigen::VectorXd* input : {&q, &v, &a}) {
-          const double h = 1e-6;
-          for (int k = 0; k < n; ++k) {
-            const double saved = (*input)[k];
-            (*input)[k] = saved + h;
-            const Outputs plus = evaluate(model, scratch, q, v, a);
-            (*input)[k] = saved - h;
-            const Outputs minus = evaluate(model, scratch, q, v, a);
-            (*input)[k] = saved;  // restored exactly
-            fdTau.col(k) = (plus.tau - minus.tau) / (2 * h);
-            fdWrench.col(k) = (plus.wrench - minus.wrench) / (2 * h);
-          }
+          // Torques and wrench stacked: rows 0…n−1 torques, n…n+5 the wrench.
+          const Eigen::MatrixXd fd = test::centralDifferences(*input, 1e-6, [&] {
+            const Outputs o = evaluate(model, scratch, q, v, a);
+            Eigen::VectorXd stacked(n + 6);
+            stacked << o.tau, o.wrench;
+            return stacked;
+          });
+          const Eigen::MatrixXd fdTau = fd.topRows(n);
+          const Eigen::MatrixXd fdWrench = fd.bottomRows(6);
           const bool isQ = input == &q, isV = input == &v;
           const Eigen::MatrixXd& analytic = isQ ? derivatives.dtauDq : isV ? derivatives.dtauDv : derivatives.dtauDa;
           const auto& analyticWrench = isQ ? derivatives.dwrenchDq : isV ? derivatives.dwrenchDv : derivatives.dwrenchDa;

@@ -2,6 +2,7 @@
 // (issue 4 acceptance), plus the wrench maps of formulation.md §5 and body motion.
 #include <catch2/catch.hpp>
 
+#include "common/finite_differences.hpp"
 #include "common/robots.hpp"
 #include "core/contact_maps.hpp"
 #include "core/dynamics_derivatives.hpp"
@@ -157,27 +158,20 @@ TEST_CASE("wrench maps: J1 is the contact frame Jacobian transposed, derivatives
     Eigen::Matrix<double, 6, Eigen::Dynamic> dWorld;
     Eigen::MatrixXd dTorque;
     wrenchMapDerivatives(model, data, contact, wrench, dWorld, dTorque);
-    Eigen::Matrix<double, 6, Eigen::Dynamic> fdWorld(6, n);
-    Eigen::MatrixXd fdTorque(n, n);
-    const double h = 1e-6;
-    for (int k = 0; k < n; ++k) {
-      Eigen::VectorXd outPlus[2];
-      Vector6 worldPlus[2];
-      for (int side = 0; side < 2; ++side) {
-        Eigen::VectorXd qs = q;
-        qs[k] += side == 0 ? h : -h;
-        forwardKinematics(model, data, qs);
-        const ContactFrame moved = contactFrame(model, data, surface.frame, surface.placement);
-        Matrix6 w;
-        WrenchToTorque t;
-        wrenchToWorld(moved, w);
-        wrenchToTorque(model, data, moved, t);
-        outPlus[side] = t * wrench;
-        worldPlus[side] = w * wrench;
-      }
-      fdTorque.col(k) = (outPlus[0] - outPlus[1]) / (2 * h);
-      fdWorld.col(k) = (worldPlus[0] - worldPlus[1]) / (2 * h);
-    }
+    // Both products with the fixed wrench, stacked: rows 0…n−1 torques, n…n+5 world wrench.
+    const Eigen::MatrixXd fd = test::centralDifferences(q, 1e-6, [&] {
+      forwardKinematics(model, data, q);
+      const ContactFrame moved = contactFrame(model, data, surface.frame, surface.placement);
+      Matrix6 w;
+      WrenchToTorque t;
+      wrenchToWorld(moved, w);
+      wrenchToTorque(model, data, moved, t);
+      Eigen::VectorXd stacked(n + 6);
+      stacked << t * wrench, w * wrench;
+      return stacked;
+    });
+    const Eigen::MatrixXd fdTorque = fd.topRows(n);
+    const Eigen::MatrixXd fdWorld = fd.bottomRows(6);
     CHECK(test::scaledError(dTorque, fdTorque) <= 1e-6);
     CHECK(test::scaledError(dWorld, fdWorld) <= 1e-6);
   }
@@ -196,24 +190,15 @@ TEST_CASE("body twist and acceleration derivatives match central differences", "
     inverseDynamics(model, data, q, v, a);
     MotionDerivative dVq, dVv, dAq, dAv, dAa;
     bodyMotionDerivatives(model, data, body, dVq, dVv, dAq, dAv, dAa);
-    auto motion = [&](Eigen::Vector<double, 12>& out) {
+    auto motion = [&] {
       inverseDynamics(model, data, q, v, a);
+      Eigen::VectorXd out(12);
       out << data.linearVelocity[body], data.angularVelocity[body], data.linearAcceleration[body],
           data.angularAcceleration[body];
+      return out;
     };
-    const double h = 1e-6;
-    Eigen::Vector<double, 12> plus, minus;
     for (Eigen::VectorXd* input : {&q, &v, &a}) {
-      Eigen::Matrix<double, 12, Eigen::Dynamic> fd(12, n);
-      for (int k = 0; k < n; ++k) {
-        const double saved = (*input)[k];
-        (*input)[k] = saved + h;
-        motion(plus);
-        (*input)[k] = saved - h;
-        motion(minus);
-        (*input)[k] = saved;
-        fd.col(k) = (plus - minus) / (2 * h);
-      }
+      const Eigen::MatrixXd fd = test::centralDifferences(*input, 1e-6, motion);
       Eigen::Matrix<double, 12, Eigen::Dynamic> analytic(12, n);
       if (input == &q) analytic << dVq, dAq;
       else if (input == &v) analytic << dVv, dAv;
