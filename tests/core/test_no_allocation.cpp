@@ -7,7 +7,7 @@
 
 #include "common/test_support.hpp"
 #include "core/bspline.hpp"
-#include "core/inverse_dynamics.hpp"
+#include "core/dynamics_derivatives.hpp"
 #include "core/kinematics.hpp"
 
 namespace {
@@ -31,10 +31,11 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 
 using namespace mcopt;
 
-TEST_CASE("one sample (spline → inverse dynamics → Jacobian) allocates nothing", "[dynamics][allocation]") {
+TEST_CASE("one sample (spline → inverse dynamics and its derivatives → Jacobian) allocates nothing", "[dynamics][allocation]") {
   const RobotModel robot = loadUrdfFile(test::hrp2().urdf);
   const DynamicsModel model(robot, "l_sole");
   DynamicsData data(model);
+  DynamicsDerivatives derivatives(model);
   const MotionParametrization parametrization(robot.jointCount());
   const SampledTrajectory samples(parametrization, 100);
   std::mt19937 rng(1);
@@ -48,10 +49,12 @@ TEST_CASE("one sample (spline → inverse dynamics → Jacobian) allocates nothi
   for (int s = 0; s < samples.sampleCount(); ++s) {
     samples.evaluate(s, points, 1.5, q, v, a);
     inverseDynamics(model, data, q, v, a);
+    inverseDynamicsDerivatives(model, data, derivatives, q, v, a);
     frameJacobian(model, data, model.framePosition(hand), framePose(model, data, hand).translation, jacobian);
   }
   CHECK(allocations.load() - before == 0);
   CHECK(data.tau.allFinite());
+  CHECK(derivatives.dtauDq.allFinite());
   // The counter works: an allocation is seen.
   const long probe = allocations.load();
   auto* p = new double[3];
