@@ -78,12 +78,10 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   const int nc = static_cast<int>(contacts.size());
   p.contactCount = nc;
   p.tikhonov = settings.tikhonov;
-  // Objective (§7): Σ w Γ² + l Γ with Γ = τ0 − J1 F.
-  const Eigen::MatrixXd weighted = weights.asDiagonal() * J1;
-  p.hessian = 2.0 * J1.transpose() * weighted;
-  p.hessian.diagonal().array() += settings.tikhonov;
-  p.gradient = -(J1.transpose() * (2.0 * weights.cwiseProduct(tau0) + linear));
-  p.constant = (weights.cwiseProduct(tau0.cwiseProduct(tau0)) + linear.cwiseProduct(tau0)).sum();
+  p.hessian.resize(6 * nc, 6 * nc);
+  p.gradient.resize(6 * nc);
+  p.weightedWrenchToTorque.resize(J1.rows(), 6 * nc);
+  updateObjective(p, J1, tau0, weights, linear);
 
   // Balance (§5): the contact wrenches moved to the world origin add up to W.
   p.balance.resize(6, 6 * nc);
@@ -96,7 +94,6 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   RowWriter rows{p.inequality, p.inequalityBound};
   for (int i = 0; i < nc; ++i) {
     const ContactSpec& c = contacts[i];
-    const double mu = c.friction;
     rows.add(i, {{Fz, -1.0}}, -c.minNormalForce);       // fz ≥ f_min
     rows.add(i, {{My, -1.0}, {Fz, -c.xMax}});            // −m_y ≤ x_max fz
     rows.add(i, {{My, 1.0}, {Fz, c.xMin}});              // x_min fz ≤ −m_y
@@ -104,11 +101,11 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
     rows.add(i, {{Mx, -1.0}, {Fz, c.yMin}});             // y_min fz ≤ m_x
     switch (settings.model) {
       case ContactModel::Report:
-        p.cones.push_back({6 * i, mu});
+        p.cones.push_back({6 * i, c.friction});
         break;
       case ContactModel::Pyramid: {
         const int k = settings.pyramidFacets;
-        const double inscribed = mu * std::cos(std::numbers::pi / k);
+        const double inscribed = c.friction * std::cos(std::numbers::pi / k);
         for (int f = 0; f < k; ++f) {
           const double theta = 2.0 * std::numbers::pi * f / k;
           rows.add(i, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
@@ -117,7 +114,10 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
       }
       case ContactModel::WrenchCone: {
         // About the rectangle's centre (cx, cy): m'_x = m_x − cy fz, m'_y = m_y + cx fz,
-        // m'_z = m_z − cx fy + cy fx.
+        // m'_z = m_z − cx fy + cy fx. With μ̃ = μ/√2 the pyramid |fx|, |fy| ≤ μ̃ fz is
+        // inscribed in the circular cone (Caron et al. §III), so the wrench cone admits
+        // nothing the report model forbids and forbids, besides, the yaw slip.
+        const double mu = c.friction / std::numbers::sqrt2;
         const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
         const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
         rows.add(i, {{Fx, 1.0}, {Fz, -mu}});
@@ -142,17 +142,44 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   return p;
 }
 
+void updateObjective(ContactProblem& p, const Eigen::Ref<const Eigen::MatrixXd>& J1,
+                     const Eigen::Ref<const Eigen::VectorXd>& tau0, const Eigen::Ref<const Eigen::VectorXd>& weights,
+                     const Eigen::Ref<const Eigen::VectorXd>& linear) {
+  if (J1.rows() != p.weightedWrenchToTorque.rows() || J1.cols() != p.hessian.cols() || tau0.size() != J1.rows() ||
+      weights.size() != J1.rows() || linear.size() != J1.rows())
+    throw InputError("inner problem update: sizes differ from the assembled problem");
+  // Objective (§7): Σ w Γ² + l Γ with Γ = τ0 − J1 F.
+  p.weightedWrenchToTorque.noalias() = weights.asDiagonal() * J1;
+  p.hessian.noalias() = 2.0 * J1.transpose() * p.weightedWrenchToTorque;
+  p.hessian.diagonal().array() += p.tikhonov;
+  p.gradient.noalias() = -2.0 * p.weightedWrenchToTorque.transpose() * tau0;
+  p.gradient.noalias() -= J1.transpose() * linear;
+  p.constant = 0.0;
+  for (Eigen::Index j = 0; j < tau0.size(); ++j) p.constant += (weights[j] * tau0[j] + linear[j]) * tau0[j];
+}
+
+void setContactPose(ContactProblem& p, int contact, const RigidTransform& pose) {
+  if (contact < 0 || contact >= p.contactCount) throw InputError("inner problem: no contact " + std::to_string(contact));
+  wrenchToWorld(pose, p.balance.middleCols<6>(6 * contact));
+}
+
 double ContactProblem::objective(const Eigen::Ref<const Eigen::VectorXd>& F) const {
-  const double regularised = 0.5 * F.dot(hessian * F) + gradient.dot(F) + constant;
-  return regularised - 0.5 * tikhonov * F.squaredNorm();
+  // ½ Fᵀ H F + cᵀ F + constant − ½ ε ‖F‖², column by column: no temporaries (called in the
+  // allocation-free inner solve).
+  double value = constant;
+  for (Eigen::Index j = 0; j < F.size(); ++j)
+    value += F[j] * (0.5 * hessian.col(j).dot(F) + gradient[j] - 0.5 * tikhonov * F[j]);
+  return value;
 }
 
 double ContactProblem::constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& F) const {
-  double worst = (balance * F - balanceTarget).cwiseAbs().maxCoeff();
-  if (inequality.rows() > 0) worst = std::max(worst, (inequality * F - inequalityBound).maxCoeff());
+  double worst = 0.0;
+  for (int k = 0; k < 6; ++k) worst = std::max(worst, std::abs(balance.row(k).dot(F) - balanceTarget[k]));
+  for (Eigen::Index i = 0; i < inequality.rows(); ++i)
+    worst = std::max(worst, inequality.row(i).dot(F) - inequalityBound[i]);
   for (const FrictionCone& cone : cones)
     worst = std::max(worst, std::hypot(F[cone.index], F[cone.index + 1]) - cone.friction * F[cone.index + 2]);
-  return std::max(worst, 0.0);
+  return worst;
 }
 
 }  // namespace mcopt

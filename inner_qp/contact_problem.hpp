@@ -14,10 +14,12 @@
 //                centre of pressure in [x_min, x_max] × [y_min, y_max]:
 //                x_min fz ≤ −m_y ≤ x_max fz,  y_min fz ≤ m_x ≤ y_max fz      (2.21, with (2.20) corrected)
 //   pyramid      the cone replaced by k facets inscribed in it: cos θ_i fx + sin θ_i fy ≤ μ cos(π/k) fz
-//   wrench-cone  Caron, Pham, Nakamura (ICRA 2015) for the rectangle, taken about its centre:
-//                |fx|, |fy| ≤ μ fz; centre of pressure as above; and the yaw bounds
-//                −μ(X+Y) fz + |Y fx − μ m_x| + |X fy − μ m_y| ≤ m_z ≤ μ(X+Y) fz − |Y fx + μ m_x| − |X fy + μ m_y|
-//                (X, Y half-sizes), each absolute value expanded into linear rows.
+//   wrench-cone  Caron, Pham, Nakamura (ICRA 2015) for the rectangle, taken about its centre,
+//                with the inscribed friction pyramid μ̃ = μ/√2 (their inner approximation):
+//                |fx|, |fy| ≤ μ̃ fz; centre of pressure as above; and the yaw bounds
+//                −μ̃(X+Y) fz + |Y fx − μ̃ m_x| + |X fy − μ̃ m_y| ≤ m_z ≤ μ̃(X+Y) fz − |Y fx + μ̃ m_x| − |X fy + μ̃ m_y|
+//                (X, Y half-sizes), each absolute value expanded into linear rows. Every
+//                wrench it admits, the report model admits; it forbids the yaw slip besides.
 
 #include <Eigen/Core>
 #include <string>
@@ -63,6 +65,7 @@ struct ContactProblem {
   Eigen::MatrixXd inequality;                        ///< G, rows × 6nc: G Fc ≤ bound
   Eigen::VectorXd inequalityBound;
   std::vector<FrictionCone> cones;                   ///< report model only
+  Eigen::MatrixXd weightedWrenchToTorque;            ///< scratch of updateObjective, n × 6nc
 
   /// Σ w Γ² + l Γ at Fc, without the Tikhonov term (what results report).
   double objective(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
@@ -79,5 +82,16 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
                                       const Eigen::Ref<const Eigen::VectorXd>& torqueWeights,
                                       const Eigen::Ref<const Eigen::VectorXd>& torqueLinear,
                                       const ContactProblemSettings& settings);
+
+/// Overwrites the objective (hessian, gradient, constant) for a new sample of a problem
+/// assembled with the same contact set and joint count; the contact rows are unchanged.
+/// Allocation-free (the per-sample path of the bilevel loop). Sizes and finiteness as for
+/// assembleContactProblem; a size mismatch throws InputError.
+void updateObjective(ContactProblem& problem, const Eigen::Ref<const Eigen::MatrixXd>& wrenchToTorque,
+                     const Eigen::Ref<const Eigen::VectorXd>& tau0, const Eigen::Ref<const Eigen::VectorXd>& torqueWeights,
+                     const Eigen::Ref<const Eigen::VectorXd>& torqueLinear);
+
+/// Moves contact i to a new world pose (its balance columns); allocation-free.
+void setContactPose(ContactProblem& problem, int contact, const RigidTransform& pose);
 
 }  // namespace mcopt

@@ -1,12 +1,14 @@
 #pragma once
 // The inner problem as a plain NLP, shared by the third-party adapters (private header).
 // Variables x = Fc (6nc). Constraints, in order:
-//   6 balance equalities   wrenchToWorld F − W = 0          (unless the balance is dropped)
+//   6 balance equalities   wrenchToWorld F − W = 0          (BalanceMode::Equality)
 //   linear inequalities    G F − h ≤ 0
 //   friction cones         fx² + fy² − μ² fz² ≤ 0          (report model), or with
 //                          coneSmoothing δ > 0 the inner smooth cone √(fx² + fy² + δ²) − μ fz ≤ 0,
 //                          whose fz-gradient never vanishes (constraint qualification holds at
 //                          an unloaded contact) and whose every point satisfies the true cone
+//   with BalanceMode::Band, after the cones: ±(wrenchToWorld F − W) − ε ≤ 0 (12 rows), the
+//   elastic phase 2's balance, whose exact equality would only touch the admissible set
 // Objective ½ Fᵀ H F + cᵀ F + constant of the given problem.
 
 #include <Eigen/Core>
@@ -17,14 +19,17 @@
 
 namespace mcopt::inner_detail {
 
+enum class BalanceMode { Equality, Dropped, Band };
+
 class InnerNlp {
  public:
-  InnerNlp(const ContactProblem& problem, bool withBalance, double coneSmoothing = 0.0)
-      : p_(problem), withBalance_(withBalance), delta_(coneSmoothing) {}
+  InnerNlp(const ContactProblem& problem, BalanceMode balance, double coneSmoothing = 0.0, double band = 0.0)
+      : p_(problem), mode_(balance), delta_(coneSmoothing), band_(band) {}
 
   int variableCount() const { return 6 * p_.contactCount; }
-  int equalityCount() const { return withBalance_ ? 6 : 0; }
-  int inequalityCount() const { return static_cast<int>(p_.inequality.rows() + p_.cones.size()); }
+  int equalityCount() const { return mode_ == BalanceMode::Equality ? 6 : 0; }
+  int bandCount() const { return mode_ == BalanceMode::Band ? 12 : 0; }
+  int inequalityCount() const { return static_cast<int>(p_.inequality.rows() + p_.cones.size()) + bandCount(); }
   const ContactProblem& problem() const { return p_; }
 
   double objective(const double* x) const {
@@ -36,7 +41,7 @@ class InnerNlp {
   }
   /// Equalities: value and dense row-major Jacobian (equalityCount × variableCount).
   void equalities(const double* x, double* value, double* jacobian) const {
-    if (!withBalance_) return;
+    if (mode_ != BalanceMode::Equality) return;
     Eigen::Map<Vector6> out(value);
     out = p_.balance * wrenches(x) - p_.balanceTarget;
     if (jacobian)
@@ -46,6 +51,7 @@ class InnerNlp {
   void inequalities(const double* x, double* value, double* jacobian) const {
     const auto F = wrenches(x);
     const Eigen::Index rows = p_.inequality.rows();
+    const Eigen::Index bandStart = rows + static_cast<Eigen::Index>(p_.cones.size());
     Eigen::Map<Eigen::VectorXd> v(value, inequalityCount());
     v.head(rows) = p_.inequality * F - p_.inequalityBound;
     for (std::size_t k = 0; k < p_.cones.size(); ++k) {
@@ -74,14 +80,32 @@ class InnerNlp {
           J(r, c.index + 2) = -2.0 * c.friction * c.friction * F[c.index + 2];
         }
       }
+      if (bandCount() > 0) {
+        J.middleRows(bandStart, 6) = p_.balance;
+        J.middleRows(bandStart + 6, 6) = -p_.balance;
+      }
+    }
+  }
+  /// Hessian of cone k's constraint on (fx, fy) (its fz part is linear or, for the
+  /// quadratic form, −2μ² on the diagonal, returned in `fz`).
+  void coneHessian(const double* x, std::size_t k, Eigen::Matrix2d& shear, double& fz) const {
+    const FrictionCone& c = p_.cones[k];
+    if (delta_ > 0.0) {
+      const Eigen::Vector2d t(x[c.index], x[c.index + 1]);
+      const double norm = std::sqrt(t.squaredNorm() + delta_ * delta_);
+      shear = (Eigen::Matrix2d::Identity() - t * t.transpose() / (norm * norm)) / norm;
+      fz = 0.0;
+    } else {
+      shear = 2.0 * Eigen::Matrix2d::Identity();
+      fz = -2.0 * c.friction * c.friction;
     }
   }
   Eigen::Map<const Eigen::VectorXd> wrenches(const double* x) const { return {x, 6 * p_.contactCount}; }
 
  private:
   const ContactProblem& p_;
-  bool withBalance_;
-  double delta_;
+  BalanceMode mode_;
+  double delta_, band_;
 };
 
 /// Wrenches, objective and active set of a solution x of `problem`.
@@ -97,12 +121,13 @@ struct RunOutcome {
   std::string message;
   bool hasMultipliers = false;
   Vector6 equalityMultipliers = Vector6::Zero();
-  Eigen::VectorXd inequalityMultipliers;  ///< linear rows then cones, ≥ 0
+  Eigen::VectorXd inequalityMultipliers;  ///< linear rows, cones, then the band's 12 rows, ≥ 0
+  double coneSmoothing = 0.0;             ///< δ of the cone form the multipliers belong to (0: quadratic)
 };
 
 /// x: starting point in, solution out (InnerNlp::variableCount()). Solver-specific choices
 /// (the cone form) are made by the runner from the problem it is given.
-using NlpRunner = RunOutcome (*)(const ContactProblem& problem, bool withBalance, const InnerSettings& settings,
+using NlpRunner = RunOutcome (*)(const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& settings,
                                  Eigen::VectorXd& x);
 
 /// The common flow (formulation.md §7): solve; if that fails or leaves the balance violated,

@@ -25,6 +25,7 @@ struct InnerSettings {
   double tolerance = 1e-9;         ///< constraint and stationarity tolerance (relative to the data's scale)
   double kktTolerance = 1e-6;      ///< a stop counts as a solution only below this KKT residual
   int maxIterations = 500;
+  bool warmStart = true;           ///< active-set method: start from the result passed in (its active set and wrenches)
 };
 
 struct InnerResult {
@@ -33,7 +34,13 @@ struct InnerResult {
   double objective = 0.0;               ///< Σ w Γ² + l Γ, without regularisation
   Vector6 balanceMultipliers = Vector6::Zero();
   Eigen::VectorXd inequalityMultipliers;  ///< ≥ 0, one per linear row
-  Eigen::VectorXd coneMultipliers;        ///< ≥ 0, one per friction cone (report model)
+  /// Per friction cone (report model) its conic multiplier y = (y_x, y_y, y_z) in the dual
+  /// cone μ‖(y_x, y_y)‖ ≤ y_z, 3 entries a cone; stationarity reads
+  ///   H F + c + balanceᵀ λ + Gᵀ μ − Σ_cones E_iᵀ y_i = 0,   y_iᵀ (fx, fy, fz)_i = 0.
+  /// On the cone's surface y = ν (−2 fx, −2 fy, 2 μ² fz) for the quadratic form's multiplier
+  /// ν; at the apex (an unloaded contact, formulation.md §7) y is any point of the dual cone,
+  /// which is what certifies an unloaded contact where the quadratic form's gradient vanishes.
+  Eigen::VectorXd coneMultipliers;
   std::vector<int> activeSet;           ///< active linear rows, then rows + cone index for active cones
   int iterations = 0;
   double kktResidual = 0.0;             ///< max of stationarity, feasibility, complementarity (see kktResidual)
@@ -52,10 +59,17 @@ class InnerSolver {
 
 std::unique_ptr<InnerSolver> makeSlsqpSolver(const InnerSettings& settings = {});
 std::unique_ptr<InnerSolver> makeIpoptSolver(const InnerSettings& settings = {});
+/// The in-house method (formulation.md §7): a dual active-set QP inside an SQP loop over the
+/// friction cones; allocation-free once it has seen a problem of the same size.
+std::unique_ptr<InnerSolver> makeActiveSetSolver(const InnerSettings& settings = {});
+
+/// Solver by name: "active-set", "slsqp" or "ipopt"; throws InputError otherwise.
+std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings = {});
 
 /// KKT residual of a result for its problem (balance shifted by the slack when Infeasible):
 /// the largest of ‖∇L‖∞ (stationarity, with the multipliers of the result), the constraint
 /// violation, and |multiplier × constraint| (complementarity), each relative to the data's scale.
+/// Allocation-free.
 double kktResidual(const ContactProblem& problem, const InnerResult& result);
 
 }  // namespace mcopt

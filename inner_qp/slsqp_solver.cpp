@@ -9,6 +9,7 @@ namespace mcopt {
 
 namespace {
 
+using inner_detail::BalanceMode;
 using inner_detail::InnerNlp;
 using inner_detail::RunOutcome;
 
@@ -32,11 +33,11 @@ void inequalities(unsigned, double* value, unsigned, const double* x, double* ja
   static_cast<Counted*>(data)->nlp->inequalities(x, value, jacobian);
 }
 
-RunOutcome runSlsqp(const ContactProblem& problem, bool withBalance, const InnerSettings& settings,
+RunOutcome runSlsqp(const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& settings,
                     Eigen::VectorXd& x) {
   // The smooth inner cone keeps SLSQP's subproblems regular at unloaded contacts; δ is far
   // below every tolerance of the result (1e-10 of the data's scale).
-  const InnerNlp nlp(problem, withBalance, 1e-10 * inner_detail::dataScale(problem));
+  const InnerNlp nlp(problem, balance, 1e-10 * inner_detail::dataScale(problem), band);
   const auto n = static_cast<unsigned>(nlp.variableCount());
   nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
   Counted counted{&nlp};

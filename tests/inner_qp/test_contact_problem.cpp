@@ -113,16 +113,41 @@ TEST_CASE("the wrench cone forbids a yaw slip that the report model allows", "[i
   std::mt19937 rng(11);
   const ContactProblem report = assemble(ContactModel::Report, rng);
   const ContactProblem wrenchCone = assemble(ContactModel::WrenchCone, rng);
-  // Foot: X = 0.115, Y = 0.065, μ = 0.7: yaw limit μ (X + Y) fz = 0.126 fz at zero shear.
+  // Foot: X = 0.115, Y = 0.065, μ̃ = 0.7/√2: yaw limit μ̃ (X + Y) fz = 0.0891 fz at zero shear.
   Eigen::VectorXd F = Eigen::VectorXd::Zero(12);
   F[2] = 100.0;
+  F[4] = -0.015 * 100.0;  // centre of pressure at the rectangle's centre, x = 0.015
   F[8] = 10.0;
-  F[5] = 0.10 * 100.0;  // within the yaw bound
+  F[5] = 0.085 * 100.0;  // within the yaw bound
   CHECK(contactViolation(report, F) == 0.0);
   CHECK(contactViolation(wrenchCone, F) == 0.0);
-  F[5] = 0.15 * 100.0;  // beyond it: the foot would spin
+  F[5] = 0.095 * 100.0;  // beyond it: the foot would spin
   CHECK(contactViolation(report, F) == 0.0);
   CHECK(contactViolation(wrenchCone, F) > 0.0);
+}
+
+TEST_CASE("the wrench cone admits nothing the report model forbids", "[inner]") {
+  std::mt19937 rng(17);
+  const ContactProblem report = assemble(ContactModel::Report, rng);
+  const ContactProblem wrenchCone = assemble(ContactModel::WrenchCone, rng);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int admitted = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    // Loaded contacts with shear, centre of pressure and yaw torque spread over and beyond
+    // what either model admits.
+    Eigen::VectorXd F(12);
+    for (int i = 0; i < 2; ++i) {
+      const double fz = 10.0 + 100.0 * std::abs(u(rng));
+      F.segment<6>(6 * i) << 0.5 * fz * u(rng), 0.5 * fz * u(rng), fz, 0.05 * fz * u(rng), 0.1 * fz * u(rng),
+          0.05 * fz * u(rng);
+    }
+    if (contactViolation(wrenchCone, F) == 0.0) {
+      ++admitted;
+      CHECK(contactViolation(report, F) <= 1e-12);
+    }
+  }
+  INFO(admitted << " of 20000 admitted by the wrench cone");
+  CHECK(admitted > 100);
 }
 
 TEST_CASE("inner problem data errors name the field or contact", "[inner][input]") {

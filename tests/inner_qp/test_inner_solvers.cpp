@@ -1,8 +1,10 @@
-// The same random inner problems through every solver (style.md §6): same optimum of the
-// report model, feasible, small KKT residual; infeasible problems end Infeasible with a
-// finite elastic solution.
+// One catalogue of random inner problems through every solver (style.md §6): same optimum
+// of the report model, feasible, KKT-certified; the pyramid's convergence to the cone; the
+// wrench cone inside the report model; infeasible samples; warm starts.
 #include <catch2/catch.hpp>
 #include <numbers>
+
+#include <limits>
 
 #include "common/test_support.hpp"
 #include "inner_qp/inner_solver.hpp"
@@ -21,6 +23,9 @@ struct RandomProblem {
 /// nc contacts — a floor foot, then feet, a hand on a wall, a hand on a table — and a
 /// balance wrench produced by an admissible set of wrenches, so the problem is feasible.
 RandomProblem randomProblem(std::mt19937& rng, int nc, int joints = 12) {
+  // 12 joints for up to 24 wrench components: H is singular on the balance's null space
+  // (up to the Tikhonov term), the hard case for a QP method; the optimum is then not unique
+  // in F, only in value.
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   RandomProblem r;
   for (int i = 0; i < nc; ++i) {
@@ -65,86 +70,260 @@ ContactProblem assemble(const RandomProblem& r, ContactModel model, int facets =
   return assembleContactProblem(r.contacts, r.wrenchToTorque, r.tau0, r.balance, r.weights, r.linear, settings);
 }
 
+/// The data scale of inner_solver.hpp's relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.
+double inner_detail_scale(const ContactProblem& p) {
+  return 1.0 + p.hessian.cwiseAbs().maxCoeff() + p.gradient.cwiseAbs().maxCoeff() + p.balanceTarget.cwiseAbs().maxCoeff();
+}
+
 double worstViolation(const ContactProblem& p, const Eigen::VectorXd& F) {
   double fzScale = 1.0;
   for (int i = 0; i < p.contactCount; ++i) fzScale = std::max(fzScale, 1.0 + std::abs(F[6 * i + 2]));
   return p.constraintViolation(F) / fzScale;
 }
 
+double minNormalForce(const ContactProblem& p, const Eigen::VectorXd& F) {
+  double least = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < p.contactCount; ++i) least = std::min(least, F[6 * i + 2]);
+  return least;
+}
+
+double relativeGap(double value, double reference) { return std::abs(value - reference) / (1.0 + std::abs(reference)); }
+
+struct SolverTally {
+  int optimal = 0;       ///< status Optimal (KKT-certified)
+  int sameOptimum = 0;   ///< finite point, feasible to 1e-8 (1 + |fz|), objective within 1e-6 of the active set's
+};
+
 }  // namespace
 
-TEST_CASE("SLSQP and Ipopt reach the same optimum of the report model", "[inner][solvers]") {
-  // Issue 5 asks for 1000 problems through three solvers with none left out. With the two
-  // third-party solvers alone, 11 of these 180 are not solved by both (typically: both stop
-  // feasible, within 1e-4 of each other, but fail the KKT check). The count is checked
-  // exactly so that any change, better or worse, is seen; the in-house method comes next.
+TEST_CASE("the three solvers reach the same optimum of the report model", "[inner][solvers][catalogue]") {
+  // Issue 5's acceptance: 1002 random feasible problems, 2, 3 and 4 contacts, the third
+  // on a wall. The active-set method must certify every one (KKT residual ≤ 1e-9); SLSQP
+  // and Ipopt must agree with it wherever they certify their own point.
   std::mt19937 rng(101);
+  auto activeSet = makeActiveSetSolver();
   auto slsqp = makeSlsqpSolver();
   auto ipopt = makeIpoptSolver();
-  int bothOptimal = 0, slsqpOptimal = 0, ipoptOptimal = 0;
+  SolverTally slsqpTally, ipoptTally;
+  int problems = 0, unloaded = 0;
+  double worstKkt = 0.0;
   for (int nc : {2, 3, 4}) {
-    for (int trial = 0; trial < 60; ++trial) {
+    for (int trial = 0; trial < 334; ++trial, ++problems) {
       const RandomProblem r = randomProblem(rng, nc);
       const ContactProblem p = assemble(r, ContactModel::Report);
-      InnerResult a, b;
-      slsqp->solve(p, a);
-      ipopt->solve(p, b);
-      INFO(nc << " contacts, trial " << trial << ": slsqp " << toString(a.status) << " (" << a.message << ") "
-              << a.objective << ", ipopt " << toString(b.status) << " (" << b.message << ") " << b.objective);
-      // Never a wrong answer called optimal: a status other than Optimal is the only way out.
-      CHECK(a.status != InnerStatus::Infeasible);
-      CHECK(b.status != InnerStatus::Infeasible);
-      slsqpOptimal += a.status == InnerStatus::Optimal;
-      ipoptOptimal += b.status == InnerStatus::Optimal;
-      if (a.status != InnerStatus::Optimal || b.status != InnerStatus::Optimal) continue;
-      ++bothOptimal;
-      CHECK(std::abs(a.objective - b.objective) <= 1e-6 * (1.0 + std::abs(b.objective)));
-      CHECK(worstViolation(p, a.wrenches) <= 1e-8);
-      CHECK(worstViolation(p, b.wrenches) <= 1e-8);
-      CHECK(a.kktResidual <= 1e-6);
-      CHECK(b.kktResidual <= 1e-6);
+      InnerResult reference;
+      activeSet->solve(p, reference);
+      INFO(nc << " contacts, trial " << trial << ": active-set " << toString(reference.status) << " ("
+              << reference.message << "), KKT " << reference.kktResidual);
+      REQUIRE(reference.status == InnerStatus::Optimal);
+      CHECK(reference.kktResidual <= 1e-9);
+      CHECK(worstViolation(p, reference.wrenches) <= 1e-8);
+      worstKkt = std::max(worstKkt, reference.kktResidual);
+      unloaded += minNormalForce(p, reference.wrenches) <= 1e-9 * inner_detail_scale(p);
+      for (auto [solver, tally] : {std::pair{slsqp.get(), &slsqpTally}, std::pair{ipopt.get(), &ipoptTally}}) {
+        InnerResult result;
+        solver->solve(p, result);
+        INFO(solver->name() << ": " << toString(result.status) << " (" << result.message << ") slack " << result.balanceSlack.transpose() << ", objective "
+                            << result.objective << " vs " << reference.objective);
+        // Never a wrong answer called optimal, never a feasible problem called infeasible.
+        CHECK(result.status != InnerStatus::Infeasible);
+        const bool agrees = result.wrenches.allFinite() && worstViolation(p, result.wrenches) <= 1e-8 &&
+                            relativeGap(result.objective, reference.objective) <= 1e-6;
+        tally->sameOptimum += agrees;
+        if (result.status != InnerStatus::Optimal) continue;
+        ++tally->optimal;
+        CHECK(agrees);
+        CHECK(result.kktResidual <= 1e-6);
+      }
     }
   }
-  WARN("of 180 problems: SLSQP optimal " << slsqpOptimal << ", Ipopt optimal " << ipoptOptimal << ", both "
-                                          << bothOptimal);
-  CHECK(bothOptimal == 169);
+  WARN("of " << problems << " problems (" << unloaded << " with an unloaded contact at the optimum): active-set "
+             << "optimal " << problems << ", worst KKT residual " << worstKkt << "; SLSQP optimal "
+             << slsqpTally.optimal << ", at the same optimum " << slsqpTally.sameOptimum << "; Ipopt optimal "
+             << ipoptTally.optimal << ", at the same optimum " << ipoptTally.sameOptimum);
+  // The degenerate case the method is built for is exercised, not avoided.
+  CHECK(unloaded >= 20);
+  // The third-party solvers fail to certify a few per cent (unloaded contacts, where the
+  // smooth cone's curvature is 1/δ, and Ipopt's iteration limit); they must still reach the
+  // same optimum on the great majority (measured: SLSQP 1001, Ipopt 969 of 1002).
+  CHECK(slsqpTally.sameOptimum >= 0.97 * problems);
+  CHECK(ipoptTally.sameOptimum >= 0.95 * problems);
 }
 
-TEST_CASE("many-facet pyramids approach the report optimum from above", "[inner][solvers]") {
-  std::mt19937 rng(103);
+TEST_CASE("with a positive definite objective the solvers agree on wrenches and multipliers too",
+          "[inner][solvers]") {
+  // 30 joints, as HRP-2: H is positive definite on the balance's null space, so the optimal
+  // wrenches are unique and, with independent active constraints, so are the multipliers.
+  std::mt19937 rng(109);
+  auto activeSet = makeActiveSetSolver();
   auto ipopt = makeIpoptSolver();
-  for (int trial = 0; trial < 10; ++trial) {
-    const RandomProblem r = randomProblem(rng, 3);
-    InnerResult cone, coarse, fine;
-    ipopt->solve(assemble(r, ContactModel::Report), cone);
-    ipopt->solve(assemble(r, ContactModel::Pyramid, 4), coarse);
-    ipopt->solve(assemble(r, ContactModel::Pyramid, 64), fine);
-    REQUIRE(cone.status == InnerStatus::Optimal);
-    if (fine.status != InnerStatus::Optimal) continue;  // an inscribed pyramid may lose feasibility
-    // Inscribed: a smaller feasible set, so never a better optimum; 64 facets close the gap.
-    CHECK(fine.objective >= cone.objective - 1e-6 * (1 + std::abs(cone.objective)));
-    CHECK(std::abs(fine.objective - cone.objective) <= 1e-2 * (1 + std::abs(cone.objective)));
-    if (coarse.status == InnerStatus::Optimal)
-      CHECK(std::abs(fine.objective - cone.objective) <= std::abs(coarse.objective - cone.objective) + 1e-9);
+  int compared = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const RandomProblem r = randomProblem(rng, 2 + trial % 3, 30);
+    const ContactProblem p = assemble(r, ContactModel::Report);
+    InnerResult a, b;
+    activeSet->solve(p, a);
+    ipopt->solve(p, b);
+    REQUIRE(a.status == InnerStatus::Optimal);
+    if (b.status != InnerStatus::Optimal) continue;
+    ++compared;
+    const double forceScale = 1.0 + a.wrenches.cwiseAbs().maxCoeff();
+    CHECK((a.wrenches - b.wrenches).cwiseAbs().maxCoeff() <= 1e-5 * forceScale);
+    const double multiplierScale = 1.0 + a.balanceMultipliers.cwiseAbs().maxCoeff();
+    CHECK((a.balanceMultipliers - b.balanceMultipliers).cwiseAbs().maxCoeff() <= 1e-4 * multiplierScale);
   }
+  CHECK(compared >= 36);
 }
 
-TEST_CASE("infeasible problems end Infeasible with a finite elastic solution", "[inner][solvers]") {
-  std::mt19937 rng(107);
-  for (auto make : {makeSlsqpSolver, makeIpoptSolver}) {
-    auto solver = make(InnerSettings{});
-    for (int trial = 0; trial < 5; ++trial) {
-      RandomProblem r = randomProblem(rng, 2);
-      for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};  // both on the floor
-      r.balance << 0, 0, -300, 0, 0, 0;                             // the floor would have to pull
-      const ContactProblem p = assemble(r, ContactModel::Report);
+TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inner][solvers]") {
+  // An inscribed k-facet pyramid loses at most 1 − cos(π/k) of the cone's radius, so its
+  // optimum is never better than the cone's and the worst gap over problems shrinks with k.
+  // (Not monotone problem by problem: a 16-facet pyramid is not inside a 64-facet one.)
+  std::mt19937 rng(103);
+  auto activeSet = makeActiveSetSolver();
+  auto ipopt = makeIpoptSolver();
+  const std::vector<int> facetCounts = {16, 64, 256, 1024};
+  std::vector<double> worstGap(facetCounts.size(), 0.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const RandomProblem r = randomProblem(rng, 2 + trial % 3);
+    InnerResult cone;
+    activeSet->solve(assemble(r, ContactModel::Report), cone);
+    REQUIRE(cone.status == InnerStatus::Optimal);
+    for (std::size_t f = 0; f < facetCounts.size(); ++f) {
+      const ContactProblem pyramid = assemble(r, ContactModel::Pyramid, facetCounts[f]);
       InnerResult result;
-      solver->solve(p, result);
-      INFO(solver->name() << ": " << result.message);
-      CHECK(result.status == InnerStatus::Infeasible);
-      CHECK(result.wrenches.allFinite());
-      CHECK(result.balanceSlack.allFinite());
-      CHECK(result.balanceSlack[2] < -299.0);  // the whole pull is slack: the contacts can only push
+      activeSet->solve(pyramid, result);
+      INFO("trial " << trial << ", " << facetCounts[f] << " facets: " << toString(result.status) << " " << result.message);
+      if (result.status == InnerStatus::Infeasible) continue;  // an inscribed pyramid may lose feasibility
+      REQUIRE(result.status == InnerStatus::Optimal);
+      CHECK(result.kktResidual <= 1e-9);
+      const double gap = (result.objective - cone.objective) / (1.0 + std::abs(cone.objective));
+      CHECK(gap >= -1e-9);
+      worstGap[f] = std::max(worstGap[f], gap);
+      if (f == 0) {  // a pure QP: the third-party solvers agree with it
+        InnerResult check;
+        ipopt->solve(pyramid, check);
+        if (check.status == InnerStatus::Optimal) CHECK(relativeGap(check.objective, result.objective) <= 1e-6);
+      }
     }
   }
+  for (std::size_t f = 1; f < facetCounts.size(); ++f) CHECK(worstGap[f] < worstGap[f - 1]);
+  CHECK(worstGap.back() <= 1e-5);
+}
+
+TEST_CASE("the wrench cone's optimum is admissible for the report model, yaw bounds held", "[inner][solvers]") {
+  std::mt19937 rng(113);
+  auto activeSet = makeActiveSetSolver();
+  int yawBinding = 0, solved = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    RandomProblem r = randomProblem(rng, 2 + trial % 3);
+    r.tau0 *= 3.0;  // strong torques: the power-optimal wrenches lean on the yaw moment too
+    const ContactProblem report = assemble(r, ContactModel::Report);
+    const ContactProblem wrenchCone = assemble(r, ContactModel::WrenchCone);
+    InnerResult a, b;
+    activeSet->solve(report, a);
+    activeSet->solve(wrenchCone, b);
+    REQUIRE(a.status == InnerStatus::Optimal);
+    if (b.status == InnerStatus::Infeasible) continue;
+    REQUIRE(b.status == InnerStatus::Optimal);
+    ++solved;
+    CHECK(b.kktResidual <= 1e-9);
+    CHECK(worstViolation(report, b.wrenches) <= 1e-8);   // no slip the report model forbids
+    CHECK(b.objective >= a.objective - 1e-6 * (1.0 + std::abs(a.objective)));
+    // Rows 9–16 of each contact are the yaw bounds (contact_problem.cpp): where the report
+    // optimum would spin a contact, the wrench cone's optimum holds it.
+    bool spins = false;
+    for (int i = 0; i < report.contactCount; ++i)
+      for (int row = 17 * i + 9; row < 17 * i + 17; ++row)
+        spins |= wrenchCone.inequality.row(row).dot(a.wrenches) - wrenchCone.inequalityBound[row] > 1e-6;
+    yawBinding += spins;
+  }
+  WARN(solved << " wrench-cone problems solved; in " << yawBinding
+              << " the report optimum would spin a contact (yaw rows violated), the wrench-cone optimum does not");
+  CHECK(solved >= 40);
+  CHECK(yawBinding >= 5);
+}
+
+TEST_CASE("infeasible problems: the active-set method proves it and finds the least slack", "[inner][solvers]") {
+  // Two feet on the floor asked for what they cannot give: to pull (every contact unloaded
+  // at the least slack, the cones' apex), to push sideways beyond friction (slip), to hold
+  // a moment beyond the support area (tip). The active-set method's QPs are relaxations of
+  // the inner problem, so its "infeasible" is a proof; its elastic solution is KKT-certified.
+  // SLSQP and Ipopt must never call such a sample optimal or return NaN; where they say
+  // infeasible, their slack can be no smaller than the least one.
+  std::mt19937 rng(107);
+  const std::vector<std::pair<const char*, Vector6>> demands = {
+      {"pull", (Vector6() << 0, 0, -300, 0, 0, 0).finished()},
+      {"slip", (Vector6() << 300, 0, 300, 0, 0, 0).finished()},
+      {"tip", (Vector6() << 0, 0, 300, 0, 150, 0).finished()}};
+  auto activeSet = makeActiveSetSolver();
+  int thirdPartyInfeasible = 0, thirdPartyRuns = 0;
+  for (const auto& [what, demand] : demands) {
+    for (int trial = 0; trial < 3; ++trial) {
+      RandomProblem r = randomProblem(rng, 2);
+      for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};  // both on the floor, at the origin
+      r.balance = demand;
+      const ContactProblem p = assemble(r, ContactModel::Report);
+      InnerResult least;
+      activeSet->solve(p, least);
+      INFO(what << ", trial " << trial << ", active-set: " << least.message << "; slack " << least.balanceSlack.transpose());
+      REQUIRE(least.status == InnerStatus::Infeasible);
+      CHECK(least.kktResidual <= 1e-9);
+      CHECK(least.balanceSlack.norm() > 1.0);
+      // Feasible for the shifted balance: the slack is what the contacts cannot give.
+      CHECK(worstViolation(p, least.wrenches) <= 1e-8 + least.balanceSlack.cwiseAbs().maxCoeff());
+      ContactProblem shifted = p;
+      shifted.balanceTarget -= least.balanceSlack;
+      CHECK(worstViolation(shifted, least.wrenches) <= 1e-8);
+      for (auto make : {makeSlsqpSolver, makeIpoptSolver}) {
+        auto solver = make(InnerSettings{});
+        InnerResult result;
+        solver->solve(p, result);
+        INFO(solver->name() << ": " << toString(result.status) << ", " << result.message << "; slack "
+                            << result.balanceSlack.transpose());
+        ++thirdPartyRuns;
+        CHECK(result.status != InnerStatus::Optimal);
+        CHECK(result.wrenches.allFinite());
+        CHECK(result.balanceSlack.allFinite());
+        if (result.status != InnerStatus::Infeasible) continue;
+        ++thirdPartyInfeasible;
+        CHECK(result.balanceSlack.norm() >= least.balanceSlack.norm() - 1e-6 * 300.0);
+        CHECK(result.balanceSlack.norm() <= 1.01 * least.balanceSlack.norm());
+      }
+    }
+  }
+  WARN("SLSQP and Ipopt certified " << thirdPartyInfeasible << " of " << thirdPartyRuns
+                                    << " infeasible samples as infeasible; the rest they report failed");
+}
+
+TEST_CASE("warm starts along a smooth motion cut the active-set iterations, not the accuracy", "[inner][solvers]") {
+  // A sequence of problems whose data move smoothly, as successive samples of a motion do.
+  std::mt19937 rng(127);
+  const RandomProblem a = randomProblem(rng, 3, 30), b = randomProblem(rng, 3, 30);
+  InnerSettings coldSettings;
+  coldSettings.warmStart = false;
+  auto warm = makeActiveSetSolver();
+  auto cold = makeActiveSetSolver(coldSettings);
+  InnerResult warmResult, coldResult;
+  long warmIterations = 0, coldIterations = 0;
+  constexpr int kSamples = 100;
+  for (int k = 0; k < kSamples; ++k) {
+    const double s = 0.5 - 0.5 * std::cos(std::numbers::pi * k / (kSamples - 1));
+    RandomProblem r = a;
+    r.wrenchToTorque = (1 - s) * a.wrenchToTorque + s * b.wrenchToTorque;
+    r.tau0 = (1 - s) * a.tau0 + s * b.tau0;
+    r.balance = (1 - s) * a.balance + s * b.balance;
+    const ContactProblem p = assemble(r, ContactModel::Report);
+    warm->solve(p, warmResult);  // the previous sample's result is the warm start
+    cold->solve(p, coldResult);
+    REQUIRE(warmResult.status == InnerStatus::Optimal);
+    REQUIRE(coldResult.status == InnerStatus::Optimal);
+    CHECK(warmResult.kktResidual <= 1e-9);
+    CHECK(relativeGap(warmResult.objective, coldResult.objective) <= 1e-9);
+    warmIterations += warmResult.iterations;
+    coldIterations += coldResult.iterations;
+  }
+  WARN("mean active-set iterations per sample: warm " << double(warmIterations) / kSamples << ", cold "
+                                                      << double(coldIterations) / kSamples);
+  CHECK(warmIterations < coldIterations);
 }
