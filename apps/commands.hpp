@@ -12,5 +12,6 @@ using Runner = std::function<int()>;
 Runner addRobotInfo(CLI::App& robot);
 Runner addDynamics(CLI::App& app);
 Runner addEvaluate(CLI::App& app);
+Runner addInner(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -6,6 +6,7 @@
 
 namespace mcopt::bench {
 void registerDynamicsBenchmarks();
+void registerInnerBenchmarks();
 }
 
 int main(int argc, char** argv) {
@@ -13,6 +14,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("mcopt_build_type", MCOPT_BUILD_TYPE);
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
   mcopt::bench::registerDynamicsBenchmarks();
+  mcopt::bench::registerInnerBenchmarks();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -200,6 +200,7 @@ void ActiveSetSolver::writeResult(const ContactProblem& p, const DualActiveSetQp
   r.inequalityMultipliers = qp.inequalityMultipliers.head(rows);
   r.coneMultipliers.setZero(3 * cones_);
   r.activeSet.clear();
+  r.activeSet.reserve(static_cast<std::size_t>(rows + cones_));  // allocates on the first solve only
   for (int row : qp.activeSet)
     if (row < rows) r.activeSet.push_back(row);
   std::sort(r.activeSet.begin(), r.activeSet.end());

@@ -47,8 +47,12 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
 struct RowWriter {
   Eigen::MatrixXd& rows;
   Eigen::VectorXd& bounds;
+  std::vector<std::string>& names;
+  const std::vector<ContactSpec>& contacts;
   Eigen::Index next = 0;
-  void add(int contact, std::initializer_list<std::pair<int, double>> terms, double bound = 0.0) {
+  void add(const std::string& name, int contact, std::initializer_list<std::pair<int, double>> terms,
+           double bound = 0.0) {
+    names.push_back(contacts[static_cast<std::size_t>(contact)].name + "." + name);
     rows.row(next).setZero();
     for (const auto& [component, value] : terms) rows(next, 6 * contact + component) += value;
     bounds[next] = bound;
@@ -91,14 +95,15 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   const int perContact = rowsPerContact(settings);
   p.inequality.resize(perContact * nc, 6 * nc);
   p.inequalityBound.resize(perContact * nc);
-  RowWriter rows{p.inequality, p.inequalityBound};
+  RowWriter rows{p.inequality, p.inequalityBound, p.rowNames, contacts};
+  for (const ContactSpec& c : contacts) p.contactNames.push_back(c.name);
   for (int i = 0; i < nc; ++i) {
     const ContactSpec& c = contacts[i];
-    rows.add(i, {{Fz, -1.0}}, -c.minNormalForce);       // fz ≥ f_min
-    rows.add(i, {{My, -1.0}, {Fz, -c.xMax}});            // −m_y ≤ x_max fz
-    rows.add(i, {{My, 1.0}, {Fz, c.xMin}});              // x_min fz ≤ −m_y
-    rows.add(i, {{Mx, 1.0}, {Fz, -c.yMax}});             // m_x ≤ y_max fz
-    rows.add(i, {{Mx, -1.0}, {Fz, c.yMin}});             // y_min fz ≤ m_x
+    rows.add("fz_min", i, {{Fz, -1.0}}, -c.minNormalForce);  // fz ≥ f_min
+    rows.add("cop_x_max", i, {{My, -1.0}, {Fz, -c.xMax}});    // −m_y ≤ x_max fz
+    rows.add("cop_x_min", i, {{My, 1.0}, {Fz, c.xMin}});      // x_min fz ≤ −m_y
+    rows.add("cop_y_max", i, {{Mx, 1.0}, {Fz, -c.yMax}});     // m_x ≤ y_max fz
+    rows.add("cop_y_min", i, {{Mx, -1.0}, {Fz, c.yMin}});     // y_min fz ≤ m_x
     switch (settings.model) {
       case ContactModel::Report:
         p.cones.push_back({6 * i, c.friction});
@@ -108,7 +113,7 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
         const double inscribed = c.friction * std::cos(std::numbers::pi / k);
         for (int f = 0; f < k; ++f) {
           const double theta = 2.0 * std::numbers::pi * f / k;
-          rows.add(i, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
+          rows.add("facet_" + std::to_string(f), i, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
         }
         break;
       }
@@ -120,18 +125,19 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
         const double mu = c.friction / std::numbers::sqrt2;
         const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
         const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
-        rows.add(i, {{Fx, 1.0}, {Fz, -mu}});
-        rows.add(i, {{Fx, -1.0}, {Fz, -mu}});
-        rows.add(i, {{Fy, 1.0}, {Fz, -mu}});
-        rows.add(i, {{Fy, -1.0}, {Fz, -mu}});
+        rows.add("fx_max", i, {{Fx, 1.0}, {Fz, -mu}});
+        rows.add("fx_min", i, {{Fx, -1.0}, {Fz, -mu}});
+        rows.add("fy_max", i, {{Fy, 1.0}, {Fz, -mu}});
+        rows.add("fy_min", i, {{Fy, -1.0}, {Fz, -mu}});
+        int yaw = 0;
         for (double s1 : {-1.0, 1.0})
           for (double s2 : {-1.0, 1.0}) {
             // m'_z ≤ μ(X+Y) fz − s1 (Y fx + μ m'_x) − s2 (X fy + μ m'_y)
-            rows.add(i, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
+            rows.add("yaw_max_" + std::to_string(yaw), i, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
                          {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, s1 * mu}, {Fz, -s1 * mu * cy},
                          {Fy, s2 * X}, {My, s2 * mu}, {Fz, s2 * mu * cx}});
             // −m'_z ≤ μ(X+Y) fz − s1 (Y fx − μ m'_x) − s2 (X fy − μ m'_y)
-            rows.add(i, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
+            rows.add("yaw_min_" + std::to_string(yaw++), i, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
                          {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, -s1 * mu}, {Fz, s1 * mu * cy},
                          {Fy, s2 * X}, {My, -s2 * mu}, {Fz, -s2 * mu * cx}});
           }

@@ -65,6 +65,10 @@ struct ContactProblem {
   Eigen::MatrixXd inequality;                        ///< G, rows × 6nc: G Fc ≤ bound
   Eigen::VectorXd inequalityBound;
   std::vector<FrictionCone> cones;                   ///< report model only
+  /// Name of each linear row, "<contact>.<row>": fz_min, cop_x_max, cop_x_min, cop_y_max,
+  /// cop_y_min, then facet_<k> (pyramid) or fx_max, fx_min, fy_max, fy_min, yaw_<k> (wrench cone).
+  std::vector<std::string> rowNames;
+  std::vector<std::string> contactNames;
   Eigen::MatrixXd weightedWrenchToTorque;            ///< scratch of updateObjective, n × 6nc
 
   /// Σ w Γ² + l Γ at Fc, without the Tikhonov term (what results report).

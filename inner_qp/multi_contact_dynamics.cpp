@@ -1,0 +1,171 @@
+#include "inner_qp/multi_contact_dynamics.hpp"
+
+#include <omp.h>
+
+#include "core/errors.hpp"
+#include "core/inverse_dynamics.hpp"
+
+namespace mcopt {
+
+void innerObjectiveTerms(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
+                         const Eigen::Ref<const Eigen::VectorXd>& acceleration, Eigen::Ref<Eigen::VectorXd> weights,
+                         Eigen::Ref<Eigen::VectorXd> linear) {
+  for (Eigen::Index j = 0; j < velocity.size(); ++j) {
+    const ActuatorParameters& m = actuators.joints[static_cast<std::size_t>(j)];
+    const double N = m.gearRatio, K = m.torqueConstant, R = m.resistance;
+    const double other = m.rotorInertia * N * acceleration[j] +
+                         frictionTorque(m, N * velocity[j], actuators.frictionSharpness);  // Γem − Γ/N
+    weights[j] = R / (K * K * N * N);
+    linear[j] = velocity[j] + 2.0 * R * other / (K * K * N);
+  }
+}
+
+struct MultiContactEvaluator::Workspace {
+  DynamicsData data;
+  ContactProblem problem;
+  std::unique_ptr<InnerSolver> solver;
+  Eigen::MatrixXd wrenchToTorque;
+  WrenchToTorque block;
+  Eigen::VectorXd weights, linear;
+  explicit Workspace(const DynamicsModel& model) : data(model) {}
+};
+
+MultiContactEvaluator::MultiContactEvaluator(const DynamicsModel& model, ActuatorSet actuators,
+                                             SampledTrajectory samples, std::vector<ContactSurface> contacts,
+                                             MultiContactSettings settings)
+    : model_(model),
+      actuators_(std::move(actuators)),
+      samples_(std::move(samples)),
+      contacts_(std::move(contacts)),
+      settings_(std::move(settings)) {
+  const int n = model.jointCount();
+  if (static_cast<int>(actuators_.joints.size()) != n)
+    throw InputError("actuator set has " + std::to_string(actuators_.joints.size()) + " joints, the robot " +
+                     std::to_string(n));
+  if (samples_.parametrization().jointCount() != n)
+    throw InputError("trajectory has " + std::to_string(samples_.parametrization().jointCount()) +
+                     " joints, the robot " + std::to_string(n));
+  if (contacts_.empty()) throw InputError("multi-contact evaluation: no contact surface given");
+  for (std::size_t j = 0; j < actuators_.joints.size(); ++j)
+    if (!(actuators_.joints[j].resistance > 0.0))
+      throw InputError("actuator of joint " + std::to_string(j) +
+                       ": winding resistance must be positive for the inner objective (formulation.md §7)");
+  const int nc = contactCount();
+  std::vector<ContactSpec> specs;
+  for (const ContactSurface& s : contacts_)
+    specs.push_back({s.name, RigidTransform{}, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0});
+  for (int t = 0; t < omp_get_max_threads(); ++t) {
+    auto w = std::make_unique<Workspace>(model);
+    w->problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, 6 * nc), Eigen::VectorXd::Zero(n),
+                                        Vector6::Zero(), Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n),
+                                        settings_.problem);
+    w->solver = makeInnerSolver(settings_.solverName, settings_.solver);
+    w->wrenchToTorque.setZero(n, 6 * nc);
+    w->block.setZero(n, 6);
+    w->weights.setZero(n);
+    w->linear.setZero(n);
+    workspaces_.push_back(std::move(w));
+  }
+  previous_.resize(static_cast<std::size_t>(samples_.sampleCount()));
+  // Room for the largest active set, so that copying warm starts never allocates.
+  const ContactProblem& sized = workspaces_.front()->problem;
+  for (InnerResult& r : previous_)
+    r.activeSet.reserve(static_cast<std::size_t>(sized.inequality.rows()) + sized.cones.size());
+}
+
+MultiContactEvaluator::~MultiContactEvaluator() = default;
+
+void MultiContactEvaluator::evaluateSample(Workspace& w, int s, double duration, MultiContactResult& r) {
+  const int nc = contactCount();
+  TrajectoryResult& m = r.motion;
+  m.time[s] = samples_.time(s, duration);
+  samples_.evaluate(s, controlPoints_, duration, m.q.col(s), m.v.col(s), m.a.col(s));
+  inverseDynamics(model_, w.data, m.q.col(s), m.v.col(s), m.a.col(s));
+  r.tau0.col(s) = w.data.tau;
+  m.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
+  // The inner problem of this sample (formulation.md §5, §7): J1, the contact poses, W0.
+  for (int i = 0; i < nc; ++i) {
+    const ContactSurface& surface = contacts_[static_cast<std::size_t>(i)];
+    const ContactFrame frame = contactFrame(model_, w.data, surface.frame, surface.placement);
+    wrenchToTorque(model_, w.data, frame, w.block);
+    w.wrenchToTorque.middleCols<6>(6 * i) = w.block;
+    setContactPose(w.problem, i, frame.contactPose);
+  }
+  innerObjectiveTerms(actuators_, m.v.col(s), m.a.col(s), w.weights, w.linear);
+  updateObjective(w.problem, w.wrenchToTorque, w.data.tau, w.weights, w.linear);
+  w.problem.balanceTarget = w.data.referenceWrench;
+  if (capture_ != nullptr) (*capture_)[static_cast<std::size_t>(s)] = w.problem;
+  InnerResult& result = previous_[static_cast<std::size_t>(s)];
+  w.solver->solve(w.problem, result);
+  r.status[static_cast<std::size_t>(s)] = result.status;
+  r.iterations[s] = result.iterations;
+  r.kktResidual[s] = result.kktResidual;
+  r.wrenches.col(s) = result.wrenches;
+  r.balanceSlack.col(s) = result.balanceSlack;
+  // Γ = Γ0 − J1 F (4.8), then the motors' power with it.
+  m.tau.col(s) = w.data.tau;
+  m.tau.col(s).noalias() -= w.wrenchToTorque * result.wrenches;
+  for (int j = 0; j < model_.jointCount(); ++j)
+    m.power(j, s) = motorPower(actuators_.joints[static_cast<std::size_t>(j)], actuators_.frictionSharpness,
+                               m.tau(j, s), m.v(j, s), m.a(j, s))
+                        .power;
+}
+
+void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
+                                     MultiContactResult& result, std::vector<ContactProblem>& sampleProblems) {
+  sampleProblems.resize(static_cast<std::size_t>(samples_.sampleCount()));
+  capture_ = &sampleProblems;
+  try {
+    evaluate(parameters, duration, result);
+  } catch (...) {
+    capture_ = nullptr;
+    throw;
+  }
+  capture_ = nullptr;
+}
+
+void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
+                                     MultiContactResult& r) {
+  const int n = model_.jointCount(), count = samples_.sampleCount(), nc = contactCount();
+  prepareTrajectoryResult(samples_, n, parameters, duration, r.motion);
+  if (r.tau0.rows() != n || r.tau0.cols() != count) {
+    r.tau0.resize(n, count);
+    r.wrenches.resize(6 * nc, count);
+    r.balanceSlack.resize(6, count);
+    r.status.assign(static_cast<std::size_t>(count), InnerStatus::Failed);
+    r.iterations.resize(count);
+    r.kktResidual.resize(count);
+  }
+  samples_.parametrization().controlPoints(parameters, controlPoints_);
+  const int threads = static_cast<int>(workspaces_.size());
+#pragma omp parallel num_threads(threads)
+  {
+    // One contiguous block of samples per thread: the warm start follows the motion.
+    const int t = omp_get_thread_num(), used = omp_get_num_threads();
+    const int first = count * t / used, last = count * (t + 1) / used;
+    Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
+    InnerResult* before = nullptr;
+    for (int s = first; s < last; ++s) {
+      InnerResult& current = previous_[static_cast<std::size_t>(s)];
+      // Within a block, the previous sample's result is the better start.
+      if (before != nullptr && settings_.solver.warmStart) {
+        current.wrenches = before->wrenches;
+        current.activeSet = before->activeSet;
+        current.inequalityMultipliers = before->inequalityMultipliers;
+        current.coneMultipliers = before->coneMultipliers;
+      }
+      evaluateSample(w, s, duration, r);
+      before = &current;
+    }
+  }
+  r.innerTimeUs = 0.0;
+  r.infeasibleSamples = r.failedSamples = 0;
+  for (int s = 0; s < count; ++s) {
+    r.innerTimeUs += previous_[static_cast<std::size_t>(s)].solveTimeUs;
+    r.infeasibleSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Infeasible;
+    r.failedSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Failed;
+  }
+  r.motion.energy = positiveEnergy(r.motion.power, r.motion.time);
+}
+
+}  // namespace mcopt

@@ -1,0 +1,82 @@
+#pragma once
+// The multi-contact "dynamic model" of the report's Figure 5.2: a whole motion, splines →
+// (q, q̇, q̈) → Newton–Euler at the fixed reference body (Γ0, W0) → at every sample the inner
+// problem picks the contact wrenches (formulation.md §5, §7) → Γ = Γ0 − J1 F → motor power →
+// energy. Samples are split into one contiguous block per thread; within a block each
+// sample's inner solve is warm-started from the previous sample, the block's first from the
+// same sample of the previous evaluation. Allocation-free after construction.
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "core/actuators.hpp"
+#include "core/bspline.hpp"
+#include "core/contact_maps.hpp"
+#include "core/robot_files.hpp"
+#include "core/trajectory_evaluation.hpp"
+#include "inner_qp/inner_solver.hpp"
+
+namespace mcopt {
+
+struct MultiContactSettings {
+  ContactProblemSettings problem;
+  InnerSettings solver;
+  std::string solverName = "active-set";  ///< active-set, slsqp or ipopt
+};
+
+struct MultiContactResult {
+  TrajectoryResult motion;           ///< time, q, q̇, q̈; tau = Γ with the chosen wrenches; power and energy from it
+  Eigen::MatrixXd tau0;              ///< Γ0: torques with the reference body alone carrying the robot, n × N
+  Eigen::MatrixXd wrenches;          ///< F, 6 nc × N, each contact's wrench in its own frame
+  Eigen::Matrix<double, 6, Eigen::Dynamic> balanceSlack;  ///< per sample (zero unless infeasible)
+  std::vector<InnerStatus> status;   ///< per sample
+  Eigen::VectorXi iterations;        ///< inner iterations per sample
+  Eigen::VectorXd kktResidual;       ///< inner KKT residual per sample (inner_solver.hpp)
+  double innerTimeUs = 0.0;          ///< summed inner solve times
+  int infeasibleSamples = 0, failedSamples = 0;
+};
+
+class MultiContactEvaluator {
+ public:
+  /// contacts: the surfaces in contact during the whole motion (the reference body's among
+  /// them, usually). Throws InputError if an actuator's resistance is not positive (the
+  /// inner objective's weights R / (K N)² must be) or sizes disagree.
+  MultiContactEvaluator(const DynamicsModel& model, ActuatorSet actuators, SampledTrajectory samples,
+                        std::vector<ContactSurface> contacts, MultiContactSettings settings = {});
+  ~MultiContactEvaluator();
+
+  const SampledTrajectory& samples() const { return samples_; }
+  int contactCount() const { return static_cast<int>(contacts_.size()); }
+
+  /// parameters: samples().parametrization().parameterCount(); duration T > 0.
+  void evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration, MultiContactResult& result);
+
+  /// The same evaluation, also copying out every sample's inner problem (allocates: for
+  /// benchmarks, tests and exporting problems to `mcopt inner`).
+  void evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration, MultiContactResult& result,
+                std::vector<ContactProblem>& sampleProblems);
+
+ private:
+  struct Workspace;
+  void evaluateSample(Workspace& w, int sample, double duration, MultiContactResult& r);
+
+  const DynamicsModel& model_;
+  ActuatorSet actuators_;
+  SampledTrajectory samples_;
+  std::vector<ContactSurface> contacts_;
+  MultiContactSettings settings_;
+  Eigen::MatrixXd controlPoints_;
+  std::vector<std::unique_ptr<Workspace>> workspaces_;  ///< one per thread
+  std::vector<InnerResult> previous_;                   ///< per sample: the warm start of the next evaluation
+  std::vector<ContactProblem>* capture_ = nullptr;
+};
+
+/// The inner objective's per-joint terms at one state (formulation.md §7): with
+/// a = I_m N q̈ + Γ_fric(N q̇), the power's Γ-dependent part is w Γ² + l Γ with
+/// w = R / (K N)², l = q̇ + 2 R a / (K² N).
+void innerObjectiveTerms(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
+                         const Eigen::Ref<const Eigen::VectorXd>& acceleration, Eigen::Ref<Eigen::VectorXd> weights,
+                         Eigen::Ref<Eigen::VectorXd> linear);
+
+}  // namespace mcopt

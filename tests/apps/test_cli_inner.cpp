@@ -1,0 +1,148 @@
+// `mcopt inner` as a user meets it: the JSON problems of docs/inner-problem.md in, one
+// result per problem out, the same answers as the library, clear errors for bad input.
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/random_inner_problem.hpp"
+#include "common/run_command.hpp"
+#include "common/temp_dir.hpp"
+#include "inner_qp/inner_solver.hpp"
+
+using namespace mcopt;
+using Catch::Matchers::Contains;
+using Json = nlohmann::json;
+
+namespace {
+
+Json toJson(const Eigen::Ref<const Eigen::VectorXd>& v) { return std::vector<double>(v.data(), v.data() + v.size()); }
+
+Json problemToJson(const test::RandomProblem& r) {
+  Json p;
+  for (const ContactSpec& c : r.contacts) {
+    const Eigen::Quaterniond q(c.pose.rotation);
+    p["contacts"].push_back({{"name", c.name},
+                             {"position", toJson(c.pose.translation)},
+                             {"quaternion_xyzw", {q.x(), q.y(), q.z(), q.w()}},
+                             {"mu", c.friction},
+                             {"rectangle", {c.xMin, c.xMax, c.yMin, c.yMax}}});
+  }
+  for (Eigen::Index i = 0; i < r.wrenchToTorque.rows(); ++i)
+    p["wrench_to_torque"].push_back(toJson(r.wrenchToTorque.row(i).transpose()));
+  p["tau0"] = toJson(r.tau0);
+  p["balance_wrench"] = toJson(r.balance);
+  p["torque_weights"] = toJson(r.weights);
+  p["torque_linear"] = toJson(r.linear);
+  return p;
+}
+
+Json readJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return Json::parse(in);
+}
+
+}  // namespace
+
+TEST_CASE("inner: every solver through the command gives that solver's library answers", "[cli][inner]") {
+  std::mt19937 rng(211);
+  std::vector<test::RandomProblem> problems;
+  for (int nc : {2, 3, 4}) problems.push_back(test::randomProblem(rng, nc));
+  test::RandomProblem pulling = test::randomProblem(rng, 2);  // both feet on the floor, asked to pull
+  for (ContactSpec& c : pulling.contacts) c.pose = RigidTransform{};
+  pulling.balance << 0, 0, -300, 0, 0, 0;
+  problems.push_back(pulling);
+  Json input;
+  for (const auto& r : problems) input["problems"].push_back(problemToJson(r));
+  test::TempDir dir;
+  const auto file = dir.write("problems.json", input.dump());
+
+  for (const char* solver : {"active-set", "slsqp", "ipopt"}) {
+    const auto out = dir.path() / (std::string(solver) + ".json");
+    const auto r = test::runMcopt("inner --problems " + test::quoted(file) + " --solver " + solver + " --out " +
+                                  test::quoted(out));
+    INFO(solver << ": " << r.errors);
+    CHECK_THAT(r.errors, Contains("4 problems"));
+    const Json results = readJson(out)["results"];
+    REQUIRE(results.size() == problems.size());
+    bool anyFailed = false;
+    for (const auto& result : results) anyFailed |= result["status"] == "failed";
+    CHECK(r.exitCode == (anyFailed ? 1 : 0));  // a failed problem is the command's failure
+    for (std::size_t k = 0; k < problems.size(); ++k) {
+      const Json& result = results[k];
+      INFO("problem " << k);
+      const ContactProblem p = test::assemble(problems[k], ContactModel::Report);
+      InnerResult expected;
+      makeInnerSolver(solver)->solve(p, expected);
+      CHECK(result["status"] == toString(expected.status));
+      REQUIRE(result["wrenches"].size() == problems[k].contacts.size());
+      Eigen::VectorXd F(6 * p.contactCount);
+      for (int i = 0; i < p.contactCount; ++i) {
+        REQUIRE(result["wrenches"][static_cast<std::size_t>(i)].size() == 6);
+        for (int c = 0; c < 6; ++c) F[6 * i + c] = result["wrenches"][static_cast<std::size_t>(i)][static_cast<std::size_t>(c)];
+      }
+      // The objective reported is the objective of the wrenches reported, without regularisation.
+      CHECK(result["objective"].get<double>() == Approx(p.objective(F)).epsilon(1e-12));
+      CHECK(std::abs(result["objective"].get<double>() - expected.objective) <= 1e-6 * (1 + std::abs(expected.objective)));
+      if (std::string(solver) == "active-set") CHECK(result["status"] == (k < 3 ? "optimal" : "infeasible"));
+      for (const char* key : {"multipliers", "active_set", "iterations", "kkt_residual", "solve_time_us", "balance_slack"})
+        CHECK(result.contains(key));
+      CHECK(result["balance_slack"].size() == 6);
+      for (const auto& name : result["active_set"]) CHECK_THAT(name.get<std::string>(), Contains("contact"));
+    }
+    if (results[3]["status"] == "infeasible") CHECK(results[3]["balance_slack"][2].get<double>() < -299.0);
+  }
+}
+
+TEST_CASE("inner: contact models, warm start on and off, standard output", "[cli][inner]") {
+  std::mt19937 rng(223);
+  Json input;
+  for (int k = 0; k < 3; ++k) input["problems"].push_back(problemToJson(test::randomProblem(rng, 3)));
+  test::TempDir dir;
+  const auto file = dir.write("problems.json", input.dump());
+  for (const char* model : {"report", "pyramid --pyramid-facets 12", "wrench-cone"}) {
+    for (const char* warm : {"", " --cold"}) {
+      const auto r = test::runMcopt("inner --problems " + test::quoted(file) + " --contact-model " + model + warm);
+      INFO(model << warm << ": " << r.errors);
+      REQUIRE(r.exitCode == 0);
+      const Json results = Json::parse(r.output)["results"];
+      REQUIRE(results.size() == 3);
+      for (const auto& result : results) {
+        CHECK(result["status"] == "optimal");
+        CHECK(result["kkt_residual"].get<double>() <= 1e-9);
+      }
+    }
+  }
+}
+
+TEST_CASE("inner: bad input names the file and field", "[cli][inner][input]") {
+  std::mt19937 rng(227);
+  test::TempDir dir;
+  const Json good = {{"problems", {problemToJson(test::randomProblem(rng, 2))}}};
+  auto expectError = [&](const Json& input, const std::string& extra, const std::vector<std::string>& fragments) {
+    const auto file = dir.write("bad.json", input.dump());
+    const auto r = test::runMcopt("inner --problems " + test::quoted(file) + extra);
+    INFO(r.errors);
+    CHECK(r.exitCode == 2);
+    for (const auto& fragment : fragments) CHECK_THAT(r.errors, Contains(fragment));
+  };
+  Json bad = good;
+  bad["problems"][0]["contacts"][1]["rectangle"] = {0.1, 0.2, 0.3};
+  expectError(bad, "", {"bad.json", "problems[0].contacts[1].rectangle", "4 numbers"});
+  bad = good;
+  bad["problems"][0]["contacts"][0]["friction"] = 0.5;
+  expectError(bad, "", {"problems[0].contacts[0].friction", "unknown key"});
+  bad = good;
+  bad["problems"][0]["tau0"][3] = "x";
+  expectError(bad, "", {"problems[0].tau0[3]", "expected a number"});
+  bad = good;
+  bad["problems"][0]["contacts"][0]["mu"] = -1.0;
+  expectError(bad, "", {"problems[0]", "contact 'contact0'", "mu"});
+  bad = good;
+  bad["problems"][0].erase("balance_wrench");
+  expectError(bad, "", {"problems[0]", "missing 'balance_wrench'"});
+  expectError(good, " --solver qpoases", {"solver", "active-set, slsqp, ipopt"});
+  expectError(good, " --contact-model soft", {"--contact-model", "report, pyramid or wrench-cone"});
+  const auto r = test::runMcopt("inner --problems " + test::quoted(dir.path() / "missing.json"));
+  CHECK(r.exitCode == 2);
+  CHECK_THAT(r.errors, Contains("missing.json") && Contains("cannot open"));
+}
