@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 #include <cmath>
+#include <functional>
 #include <string>
 
 #include "inner_qp/inner_solver.hpp"
@@ -127,14 +128,14 @@ struct RunOutcome {
 
 /// x: starting point in, solution out (InnerNlp::variableCount()). Solver-specific choices
 /// (the cone form) are made by the runner from the problem it is given.
-using NlpRunner = RunOutcome (*)(const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& settings,
-                                 Eigen::VectorXd& x);
+using NlpRunner = std::function<RunOutcome(const ContactProblem& problem, BalanceMode balance, double band,
+                                            const InnerSettings& settings, Eigen::VectorXd& x)>;
 
 /// The common flow (formulation.md §7): solve; if that fails or leaves the balance violated,
 /// find the balance slack of least norm (min ‖wrenchToWorld F − W‖² under the contact
 /// constraints), solve again with the balance shifted by it, and report Infeasible with that
 /// slack when it is not zero. Fills the whole result.
-void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, NlpRunner run,
+void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, const NlpRunner& run,
                               InnerResult& result);
 
 /// Scale of the data for relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.

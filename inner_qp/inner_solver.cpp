@@ -190,7 +190,7 @@ void takeMultipliers(const ContactProblem& p, const RunOutcome& outcome, InnerRe
   }
 }
 
-void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& settings, NlpRunner run,
+void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& settings, const NlpRunner& run,
                               InnerResult& r) {
   const auto start = std::chrono::steady_clock::now();
   const int n = 6 * p.contactCount;

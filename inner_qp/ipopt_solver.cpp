@@ -117,16 +117,10 @@ class InnerTnlp final : public Ipopt::TNLP {
   std::vector<double> buffer_;
 };
 
-RunOutcome runIpopt(const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& settings,
-                    Eigen::VectorXd& x) {
-  // The smooth inner cone, as for SLSQP: with the report's quadratic form fx² + fy² ≤ μ² fz²
-  // Ipopt failed on 11 of the 180 catalogue problems (its gradient vanishes at an unloaded
-  // contact, where constraint qualification fails), with the smooth form on 4 (measured with
-  // tests/inner_qp/test_inner_solvers.cpp).
-  const double smoothing = 1e-10 * inner_detail::dataScale(problem);
-  const InnerNlp nlp(problem, balance, smoothing, band);
-  RunOutcome outcome;
-  outcome.coneSmoothing = smoothing;
+/// One Ipopt application per solver object, its options set and initialised once (creating
+/// and initialising one per solve cost ~8 ms, more than the solve itself: measured with
+/// Inner/ipopt/*).
+Ipopt::SmartPtr<Ipopt::IpoptApplication> makeApplication(const InnerSettings& settings) {
   Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
   app->RethrowNonIpoptException(true);
   app->Options()->SetIntegerValue("print_level", 0);
@@ -138,7 +132,21 @@ RunOutcome runIpopt(const ContactProblem& problem, BalanceMode balance, double b
   // Feasibility is judged on the problem as given: no relaxed bounds, no internal scaling.
   app->Options()->SetNumericValue("bound_relax_factor", 0.0);
   app->Options()->SetStringValue("nlp_scaling_method", "none");
-  if (app->Initialize() != Ipopt::Solve_Succeeded) {
+  if (app->Initialize() != Ipopt::Solve_Succeeded) return nullptr;
+  return app;
+}
+
+RunOutcome runIpopt(Ipopt::IpoptApplication* app, const ContactProblem& problem, BalanceMode balance, double band,
+                    Eigen::VectorXd& x) {
+  // The smooth inner cone, as for SLSQP: with the report's quadratic form fx² + fy² ≤ μ² fz²
+  // Ipopt failed on 11 of the 180 catalogue problems (its gradient vanishes at an unloaded
+  // contact, where constraint qualification fails), with the smooth form on 4 (measured with
+  // tests/inner_qp/test_inner_solvers.cpp).
+  const double smoothing = 1e-10 * inner_detail::dataScale(problem);
+  const InnerNlp nlp(problem, balance, smoothing, band);
+  RunOutcome outcome;
+  outcome.coneSmoothing = smoothing;
+  if (app == nullptr) {
     outcome.message = "ipopt: initialisation failed";
     return outcome;
   }
@@ -153,14 +161,21 @@ RunOutcome runIpopt(const ContactProblem& problem, BalanceMode balance, double b
 
 class IpoptSolver final : public InnerSolver {
  public:
-  explicit IpoptSolver(const InnerSettings& settings) : settings_(settings) {}
+  explicit IpoptSolver(const InnerSettings& settings) : settings_(settings), app_(makeApplication(settings)) {}
   std::string name() const override { return "ipopt"; }
   void solve(const ContactProblem& problem, InnerResult& result) override {
-    inner_detail::solveWithElasticFallback(problem, settings_, runIpopt, result);
+    Ipopt::IpoptApplication* app = Ipopt::GetRawPtr(app_);
+    inner_detail::solveWithElasticFallback(
+        problem, settings_,
+        [app](const ContactProblem& p, BalanceMode balance, double band, const InnerSettings&, Eigen::VectorXd& x) {
+          return runIpopt(app, p, balance, band, x);
+        },
+        result);
   }
 
  private:
   InnerSettings settings_;
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app_;
 };
 
 }  // namespace
