@@ -7,13 +7,15 @@
 #include "apps/json_io.hpp"
 #include "core/atomic_file.hpp"
 #include "inner_qp/inner_solver.hpp"
+#include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt::cli {
 
 namespace {
 
 struct InnerOptions {
-  std::string problems, out, solver = "active-set", contactModel = "report";
+  std::string problems, out, solver = "active-set", contactModel = "report", kktBackend = "dense";
+  bool sensitivity = false;
   int pyramidFacets = 8;
   double tikhonov = 1e-9;
   bool cold = false;
@@ -139,6 +141,24 @@ Json resultToJson(const ContactProblem& p, const InnerResult& r) {
   return out;
 }
 
+/// dF/dτ0 and dF/dW (formulation.md §8), rows in the order of the stacked wrenches; null
+/// with the reason where the result is not optimal.
+void addSensitivity(const ContactProblem& p, const InnerResult& r, const SensitivitySettings& settings, Json& out) {
+  if (r.status != InnerStatus::Optimal) {
+    out["dwrenches_dtau0"] = nullptr;
+    out["dwrenches_dbalance"] = nullptr;
+    out["sensitivity"] = {{"note", std::string("no derivative: the result is ") + toString(r.status)}};
+    return;
+  }
+  InnerSensitivity sensitivity(settings);
+  const SensitivityDiagnostics& d = sensitivity.factorize(p, r);
+  Eigen::MatrixXd dTau0, dBalance;
+  sensitivity.dataSensitivities(p, dTau0, dBalance);
+  out["dwrenches_dtau0"] = json_io::matrixToJson(dTau0);
+  out["dwrenches_dbalance"] = json_io::matrixToJson(dBalance);
+  out["sensitivity"] = {{"degenerate", d.degenerate()}, {"diagnostics", d.describe()}};
+}
+
 int runInner(const InnerOptions& o) {
   const std::filesystem::path file = o.problems;
   const Json input = json_io::readFile(file);
@@ -152,6 +172,8 @@ int runInner(const InnerOptions& o) {
   InnerSettings solverSettings;
   solverSettings.warmStart = !o.cold;
   auto solver = makeInnerSolver(o.solver, solverSettings);
+  SensitivitySettings sensitivitySettings;
+  sensitivitySettings.backend = parseKktBackend(o.kktBackend);
 
   Json results = Json::array();
   std::map<std::string, int> statusCounts;
@@ -169,7 +191,9 @@ int runInner(const InnerOptions& o) {
     }
     if (previous.wrenches.size() != 6 * p.contactCount) previous = InnerResult{};
     solver->solve(p, previous);
-    results.push_back(resultToJson(p, previous));
+    Json result = resultToJson(p, previous);
+    if (o.sensitivity) addSensitivity(p, previous, sensitivitySettings, result);
+    results.push_back(result);
     ++statusCounts[toString(previous.status)];
     totalTime += previous.solveTimeUs;
     totalIterations += previous.iterations;
@@ -204,6 +228,9 @@ Runner addInner(CLI::App& app) {
   app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8)");
   app.add_option("--tikhonov", o->tikhonov, "ε added to the objective's Hessian diagonal (default 1e-9)");
   app.add_flag("--cold", o->cold, "do not warm-start each problem from the previous one's result");
+  app.add_flag("--sensitivity", o->sensitivity,
+               "add dwrenches_dtau0 and dwrenches_dbalance (formulation.md §8) to each optimal result");
+  app.add_option("--kkt-backend", o->kktBackend, "factorisation of the sensitivity's KKT system: dense (default), klu, umfpack");
   app.add_option("--out", o->out, "write the results there (atomically) instead of standard output");
   return [o] { return runInner(*o); };
 }

@@ -146,3 +146,54 @@ TEST_CASE("inner: bad input names the file and field", "[cli][inner][input]") {
   CHECK(r.exitCode == 2);
   CHECK_THAT(r.errors, Contains("missing.json") && Contains("cannot open"));
 }
+
+TEST_CASE("inner --sensitivity agrees with finite differences of mcopt inner itself", "[cli][inner][sensitivity]") {
+  std::mt19937 rng(229);
+  const test::RandomProblem base = test::randomProblem(rng, 3, 30);
+  // One file: the problem, then each moved one way and the other (solved --cold, independently).
+  const std::vector<int> moved = {0, 11, 29, 30 + 2, 30 + 4};  // τ0 entries, then W entries
+  Json input;
+  input["problems"].push_back(problemToJson(base));
+  std::vector<double> steps;
+  for (int which : moved) {
+    const double step = which < 30 ? 3e-3 : 3e-2;
+    steps.push_back(step);
+    for (double sign : {1.0, -1.0}) {
+      test::RandomProblem r = base;
+      if (which < 30)
+        r.tau0[which] += sign * step;
+      else
+        r.balance[which - 30] += sign * step;
+      input["problems"].push_back(problemToJson(r));
+    }
+  }
+  test::TempDir dir;
+  const auto file = dir.write("problems.json", input.dump());
+  for (const char* backend : {"dense", "klu", "umfpack"}) {
+    const auto r = test::runMcopt("inner --cold --sensitivity --kkt-backend " + std::string(backend) + " --problems " +
+                                  test::quoted(file));
+    INFO(backend << ": " << r.errors);
+    REQUIRE(r.exitCode == 0);
+    const Json results = Json::parse(r.output)["results"];
+    const Json& first = results[0];
+    REQUIRE(first["status"] == "optimal");
+    REQUIRE(first["dwrenches_dtau0"].size() == 18);
+    REQUIRE(first["dwrenches_dtau0"][0].size() == 30);
+    REQUIRE(first["dwrenches_dbalance"].size() == 18);
+    REQUIRE(first["dwrenches_dbalance"][0].size() == 6);
+    CHECK(first["sensitivity"]["degenerate"] == false);
+    for (std::size_t k = 0; k < moved.size(); ++k) {
+      const Json& plus = results[1 + 2 * k]["wrenches"];
+      const Json& minus = results[2 + 2 * k]["wrenches"];
+      for (std::size_t row = 0; row < 18; ++row) {
+        const double difference = (plus[row / 6][row % 6].get<double>() - minus[row / 6][row % 6].get<double>()) /
+                                  (2.0 * steps[k]);
+        const double analytic = moved[k] < 30 ? first["dwrenches_dtau0"][row][static_cast<std::size_t>(moved[k])].get<double>()
+                                              : first["dwrenches_dbalance"][row][static_cast<std::size_t>(moved[k] - 30)].get<double>();
+        INFO("parameter " << moved[k] << ", row " << row);
+        // The JSON's 17 significant digits and the solves' own accuracy bound the agreement.
+        CHECK(std::abs(analytic - difference) <= 1e-6 * std::max(1.0, std::abs(difference)));
+      }
+    }
+  }
+}

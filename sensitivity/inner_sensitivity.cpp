@@ -1,0 +1,206 @@
+#include "sensitivity/inner_sensitivity.hpp"
+
+#include <Eigen/KLUSupport>
+#include <Eigen/LU>
+#include <Eigen/QR>
+#include <Eigen/SparseCore>
+#include <Eigen/UmfPackSupport>
+#include <sstream>
+#include <vector>
+
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+const char* toString(KktBackend backend) {
+  switch (backend) {
+    case KktBackend::Dense: return "dense";
+    case KktBackend::SparseKlu: return "klu";
+    case KktBackend::SparseUmfpack: return "umfpack";
+  }
+  return "dense";
+}
+
+KktBackend parseKktBackend(const std::string& name) {
+  if (name == "dense") return KktBackend::Dense;
+  if (name == "klu") return KktBackend::SparseKlu;
+  if (name == "umfpack") return KktBackend::SparseUmfpack;
+  throw InputError("KKT backend: expected dense, klu or umfpack; got '" + name + "'");
+}
+
+std::string SensitivityDiagnostics::describe() const {
+  std::ostringstream s;
+  s << "KKT " << size << " × " << size << ": " << activeRows << " active rows, " << activeCones << " active cones, "
+    << unloadedContacts << " unloaded contacts";
+  if (weaklyActive > 0) s << "; " << weaklyActive << " weakly active constraints left out (one-sided derivatives)";
+  if (reciprocalCondition < 1e-13) s << "; near-singular (reciprocal condition " << reciprocalCondition << ")";
+  return s.str();
+}
+
+struct InnerSensitivity::Impl {
+  SensitivitySettings settings;
+  SensitivityDiagnostics diagnostics;
+  int variables = 0;
+  Eigen::MatrixXd kkt;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
+  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> rankRevealing;
+  bool useRankRevealing = false;
+  Eigen::SparseMatrix<double> sparse;
+  Eigen::KLU<Eigen::SparseMatrix<double>> klu;
+  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> umfpack;
+  KktBackend used = KktBackend::Dense;
+  Eigen::MatrixXd weightedWrenchToTorque;  ///< diag(w) J1 of the factorised problem, for dataSensitivities
+};
+
+InnerSensitivity::InnerSensitivity(SensitivitySettings settings) : impl_(std::make_unique<Impl>()) {
+  impl_->settings = settings;
+}
+InnerSensitivity::~InnerSensitivity() = default;
+InnerSensitivity::InnerSensitivity(InnerSensitivity&&) noexcept = default;
+InnerSensitivity& InnerSensitivity::operator=(InnerSensitivity&&) noexcept = default;
+
+const SensitivityDiagnostics& InnerSensitivity::diagnostics() const { return impl_->diagnostics; }
+
+const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& p, const InnerResult& r) {
+  Impl& m = *impl_;
+  const int nc = p.contactCount, n = 6 * nc;
+  if (r.status != InnerStatus::Optimal)
+    throw InputError(std::string("sensitivity: the inner result is ") + toString(r.status) +
+                     ", not optimal: no derivative of the optimal wrenches exists there");
+  if (r.wrenches.size() != n || r.inequalityMultipliers.size() != p.inequality.rows() ||
+      r.coneMultipliers.size() != 3 * static_cast<Eigen::Index>(p.cones.size()))
+    throw InputError("sensitivity: the inner result does not belong to this problem (sizes differ)");
+  m.variables = n;
+  m.diagnostics = {};
+  m.weightedWrenchToTorque = p.weightedWrenchToTorque;
+  const Eigen::VectorXd& F = r.wrenches;
+  const double scale = 1.0 + p.hessian.cwiseAbs().maxCoeff() + p.gradient.cwiseAbs().maxCoeff() +
+                       p.balanceTarget.cwiseAbs().maxCoeff();
+  const double strict = m.settings.strictMultiplier * scale;
+  const double forceScale = 1.0 + F.cwiseAbs().maxCoeff();
+  const auto rowCount = static_cast<int>(p.inequality.rows());
+  const int perContact = rowCount / nc;  // assembly order: each contact's rows together, fz_min first
+  std::vector<char> active(static_cast<std::size_t>(rowCount + static_cast<int>(p.cones.size())), 0);
+  for (int a : r.activeSet) active[static_cast<std::size_t>(a)] = 1;
+
+  Eigen::MatrixXd lagrangianHessian = p.hessian;
+  std::vector<Eigen::RowVectorXd> rows;  // the system's constraint rows beyond the balance
+  for (int i = 0; i < nc; ++i) {
+    const int fzRow = perContact * i;
+    const double fz = F[6 * i + 2];
+    const int cone = p.cones.empty() ? -1 : i;  // report model: cone i belongs to contact i
+    // Held at zero by its fz_min row or by its cone's apex (the active-set method certifies
+    // an unloaded contact through the cone's planes, whose multipliers make y_z).
+    const bool apex = cone >= 0 && active[static_cast<std::size_t>(rowCount + cone)];
+    if ((active[static_cast<std::size_t>(fzRow)] || apex) && std::abs(fz) <= m.settings.unloadedForce * forceScale) {
+      // Unloaded: held at zero wrench while its pushing multiplier is positive.
+      ++m.diagnostics.unloadedContacts;
+      double push = r.inequalityMultipliers[fzRow];
+      if (cone >= 0) push += r.coneMultipliers[3 * cone + 2];
+      if (!(push > strict)) ++m.diagnostics.weaklyActive;
+      bool yawHeld = false;
+      for (int k = fzRow; k < fzRow + perContact; ++k) yawHeld |= p.inequality(k, 6 * i + 5) != 0.0;
+      for (int component = 0; component < (yawHeld ? 6 : 5); ++component) {
+        Eigen::RowVectorXd unit = Eigen::RowVectorXd::Zero(n);
+        unit[6 * i + component] = 1.0;
+        rows.push_back(unit);
+      }
+      continue;
+    }
+    for (int k = fzRow; k < fzRow + perContact; ++k) {
+      if (!active[static_cast<std::size_t>(k)]) continue;
+      if (r.inequalityMultipliers[k] > strict) {
+        rows.push_back(p.inequality.row(k));
+        ++m.diagnostics.activeRows;
+      } else {
+        ++m.diagnostics.weaklyActive;
+      }
+    }
+    if (cone >= 0 && active[static_cast<std::size_t>(rowCount + cone)]) {
+      const FrictionCone& c = p.cones[static_cast<std::size_t>(cone)];
+      const double nu = r.coneMultipliers[3 * cone + 2] / c.friction;
+      const Eigen::Vector2d shear = F.segment<2>(c.index);
+      const double norm = shear.norm();
+      if (nu > strict && norm > 0.0) {
+        const Eigen::Vector2d u = shear / norm;
+        Eigen::RowVectorXd gradient = Eigen::RowVectorXd::Zero(n);
+        gradient[c.index] = u.x();
+        gradient[c.index + 1] = u.y();
+        gradient[c.index + 2] = -c.friction;
+        rows.push_back(gradient);
+        lagrangianHessian.block<2, 2>(c.index, c.index) += (nu / norm) * (Eigen::Matrix2d::Identity() - u * u.transpose());
+        ++m.diagnostics.activeCones;
+      } else {
+        ++m.diagnostics.weaklyActive;
+      }
+    }
+  }
+
+  const int size = n + 6 + static_cast<int>(rows.size());
+  m.diagnostics.size = size;
+  m.kkt.setZero(size, size);
+  m.kkt.topLeftCorner(n, n) = lagrangianHessian;
+  m.kkt.block(n, 0, 6, n) = p.balance;
+  m.kkt.block(0, n, n, 6) = p.balance.transpose();
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const int at = n + 6 + static_cast<int>(k);
+    m.kkt.block(at, 0, 1, n) = rows[k];
+    m.kkt.block(0, at, n, 1) = rows[k].transpose();
+  }
+
+  // Dense LU always gives the condition estimate; a near-singular system (dependent active
+  // rows, whose multipliers are then not unique while dF is) is solved in the least-norm sense.
+  m.lu.compute(m.kkt);
+  m.diagnostics.reciprocalCondition = m.lu.rcond();
+  m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
+  if (m.useRankRevealing) m.rankRevealing.compute(m.kkt);
+  m.used = KktBackend::Dense;
+  if (m.settings.backend != KktBackend::Dense && !m.useRankRevealing) {
+    m.sparse = m.kkt.sparseView();
+    if (m.settings.backend == KktBackend::SparseKlu) {
+      m.klu.compute(m.sparse);
+      if (m.klu.info() == Eigen::Success) m.used = KktBackend::SparseKlu;
+    } else {
+      m.umfpack.compute(m.sparse);
+      if (m.umfpack.info() == Eigen::Success) m.used = KktBackend::SparseUmfpack;
+    }
+  }
+  return m.diagnostics;
+}
+
+void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity,
+                             const Eigen::Ref<const Eigen::MatrixXd>& dBalance, Eigen::MatrixXd& dWrenches,
+                             Eigen::MatrixXd* dBalanceMultipliers) const {
+  const Impl& m = *impl_;
+  const int n = m.variables, size = m.diagnostics.size;
+  if (size == 0) throw InputError("sensitivity: solve before factorize");
+  if (dStationarity.rows() != n || dBalance.rows() != 6 || dStationarity.cols() != dBalance.cols())
+    throw InputError("sensitivity: right-hand sides must be 6nc × m and 6 × m");
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size, dStationarity.cols());
+  rhs.topRows(n) = -dStationarity;
+  rhs.middleRows(n, 6) = -dBalance;
+  Eigen::MatrixXd solution;
+  switch (m.used) {
+    case KktBackend::SparseKlu: solution = m.klu.solve(rhs); break;
+    case KktBackend::SparseUmfpack: solution = m.umfpack.solve(rhs); break;
+    case KktBackend::Dense:
+      if (m.useRankRevealing)
+        solution = m.rankRevealing.solve(rhs);
+      else
+        solution = m.lu.solve(rhs);
+      break;
+  }
+  dWrenches = solution.topRows(n);
+  if (dBalanceMultipliers != nullptr) *dBalanceMultipliers = solution.middleRows(n, 6);
+}
+
+void InnerSensitivity::dataSensitivities(const ContactProblem& p, Eigen::MatrixXd& dTau0,
+                                         Eigen::MatrixXd& dBalanceWrench) const {
+  const int n = impl_->variables;
+  if (p.weightedWrenchToTorque.cols() != n) throw InputError("sensitivity: problem differs from the factorised one");
+  const Eigen::MatrixXd dStationarityDtau0 = -2.0 * p.weightedWrenchToTorque.transpose();  // ∂c/∂τ0
+  solve(dStationarityDtau0, Eigen::MatrixXd::Zero(6, dStationarityDtau0.cols()), dTau0);
+  solve(Eigen::MatrixXd::Zero(n, 6), -Eigen::MatrixXd::Identity(6, 6), dBalanceWrench);  // ∂(B F − W)/∂W = −1
+}
+
+}  // namespace mcopt

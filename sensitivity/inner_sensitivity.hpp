@@ -1,0 +1,90 @@
+#pragma once
+// Sensitivity of an inner solution (formulation.md §8; the report's (4.25)–(4.47)): at the
+// optimal wrenches F with strictly active set A, the KKT conditions
+//     ∇_F L = H F + c + Bᵀ λ + Σ_A μ_r a_r + Σ_cones ν_k ∇c_k = 0,    B F = W,   a_r F = b_r,   c_k(F) = 0
+// hold identically in any parameter p of the data, so
+//     [ H + Σ ν_k ∇²c_k   Aᵀ ] [ dF/dp ]       [ ∂(∇_F L)/∂p ]
+//     [ A                 0  ] [ dμ/dp ]  = −  [ ∂(A F − b)/∂p ]
+// with A stacking the balance rows, the strictly active linear rows and the active cones'
+// gradients (convex form c = ‖f_t‖ − μ fz, ν = y_z / μ of the conic multiplier). One
+// factorisation serves every parameter column.
+//
+// Unloaded contacts (formulation.md §7): a contact whose fz sits at zero with a positive
+// multiplier stays unloaded under small perturbations, and its centre-of-pressure rows then
+// pin m_x = m_y = 0 (its yaw rows, in the wrench-cone model, m_z = 0): its wrench components
+// are held by unit rows and its own rows and cone leave the system.
+//
+// Degenerate points — an active constraint with (near) zero multiplier, or a near-singular
+// KKT matrix — have one-sided derivatives only: they are counted in the diagnostics, the
+// weakly active constraints are left out (the derivative of the strictly active side), never
+// silently.
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "inner_qp/inner_solver.hpp"
+
+namespace mcopt {
+
+enum class KktBackend {
+  Dense,       ///< Eigen partial-pivoting LU of the per-sample KKT matrix
+  SparseKlu,   ///< SuiteSparse KLU (through Eigen's KLUSupport)
+  SparseUmfpack,  ///< SuiteSparse UMFPACK (through Eigen's UmfPackSupport)
+};
+const char* toString(KktBackend backend);
+/// "dense", "klu" or "umfpack"; throws InputError otherwise.
+KktBackend parseKktBackend(const std::string& name);
+
+struct SensitivitySettings {
+  KktBackend backend = KktBackend::Dense;
+  /// A constraint whose multiplier is at most this fraction of the data's scale is weakly
+  /// active: left out of the system and counted as degenerate.
+  double strictMultiplier = 1e-9;
+  /// A contact with fz below this fraction of the force scale and its fz_min row active is unloaded.
+  double unloadedForce = 1e-9;
+};
+
+struct SensitivityDiagnostics {
+  int activeRows = 0;        ///< strictly active linear rows in the system
+  int activeCones = 0;       ///< cones active on their surface
+  int unloadedContacts = 0;  ///< contacts held at zero wrench
+  int weaklyActive = 0;      ///< active constraints with (near) zero multiplier, left out
+  double reciprocalCondition = 1.0;  ///< of the KKT matrix (dense: LU estimate; sparse: 1/‖K‖‖K⁻¹‖ estimate unavailable, 1)
+  int size = 0;              ///< KKT dimension
+  bool degenerate() const { return weaklyActive > 0 || reciprocalCondition < 1e-13; }
+  std::string describe() const;
+};
+
+class InnerSensitivity {
+ public:
+  explicit InnerSensitivity(SensitivitySettings settings = {});
+  ~InnerSensitivity();
+  InnerSensitivity(InnerSensitivity&&) noexcept;
+  InnerSensitivity& operator=(InnerSensitivity&&) noexcept;
+
+  /// Assembles and factorises the KKT system at an optimal inner result of `problem`.
+  /// Throws InputError if the result is not optimal (an infeasible sample's elastic solution
+  /// has no such derivative; the outer problem sees its slack instead) or sizes disagree.
+  const SensitivityDiagnostics& factorize(const ContactProblem& problem, const InnerResult& result);
+  const SensitivityDiagnostics& diagnostics() const;
+
+  /// m parameter directions at once. dStationarity: 6nc × m, ∂(∇_F L)/∂p at fixed F and
+  /// multipliers; dBalance: 6 × m, ∂(B F − W)/∂p at fixed F. Writes dWrenches (6nc × m) and,
+  /// when given, dBalanceMultipliers (6 × m). The contact rows do not depend on p (they live
+  /// in the contact frames).
+  void solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity, const Eigen::Ref<const Eigen::MatrixXd>& dBalance,
+             Eigen::MatrixXd& dWrenches, Eigen::MatrixXd* dBalanceMultipliers = nullptr) const;
+
+  /// The data sensitivities of `mcopt inner --sensitivity`: dF/dτ0 (6nc × n) and dF/dW
+  /// (6nc × 6), from ∂c/∂τ0 = −2 J1ᵀ diag(w) (the problem's weightedWrenchToTorque) and
+  /// ∂(B F − W)/∂W = −1.
+  void dataSensitivities(const ContactProblem& problem, Eigen::MatrixXd& dWrenchesDtau0,
+                         Eigen::MatrixXd& dWrenchesDbalance) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace mcopt

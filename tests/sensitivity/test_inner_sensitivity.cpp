@@ -1,0 +1,201 @@
+// Derivatives of the inner solution from its KKT system (formulation.md §8), checked
+// against central differences of the re-solved problem and against the envelope theorem.
+#include <catch2/catch.hpp>
+
+#include "common/random_inner_problem.hpp"
+#include "core/errors.hpp"
+#include "sensitivity/inner_sensitivity.hpp"
+
+using namespace mcopt;
+
+namespace {
+
+/// Re-solves the problem with τ0 (or W) moved and returns the wrenches, from a cold start
+/// so that each difference is an independent solve.
+Eigen::VectorXd solveMoved(InnerSolver& solver, test::RandomProblem r, int which, double step) {
+  if (which < r.tau0.size())
+    r.tau0[which] += step;
+  else
+    r.balance[which - r.tau0.size()] += step;
+  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  InnerResult result;
+  solver.solve(p, result);
+  REQUIRE(result.status == InnerStatus::Optimal);
+  return result.wrenches;
+}
+
+double optimalValue(InnerSolver& solver, test::RandomProblem r, int which, double step) {
+  if (which < r.tau0.size())
+    r.tau0[which] += step;
+  else
+    r.balance[which - r.tau0.size()] += step;
+  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  InnerResult result;
+  solver.solve(p, result);
+  REQUIRE(result.status == InnerStatus::Optimal);
+  return p.objective(result.wrenches) + 0.5 * p.tikhonov * result.wrenches.squaredNorm();  // what the solver minimises
+}
+
+}  // namespace
+
+TEST_CASE("dF/dτ0 and dF/dW agree with central differences of the re-solved problem", "[sensitivity]") {
+  // 30 joints (as HRP-2): the optimal wrenches are unique, so F(p) is a function to differentiate.
+  std::mt19937 rng(301);
+  InnerSettings cold;
+  cold.warmStart = false;
+  auto activeSet = makeActiveSetSolver(cold);
+  int checked = 0, degenerate = 0, withCone = 0, unloaded = 0;
+  for (int trial = 0; trial < 24; ++trial) {
+    const int nc = 2 + trial % 3;
+    const test::RandomProblem r = test::randomProblem(rng, nc, 30);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult solution;
+    activeSet->solve(p, solution);
+    REQUIRE(solution.status == InnerStatus::Optimal);
+    InnerSensitivity sensitivity;
+    const SensitivityDiagnostics& d = sensitivity.factorize(p, solution);
+    INFO("trial " << trial << ": " << d.describe());
+    if (d.degenerate()) {  // one-sided derivatives only: reported, not checked here
+      ++degenerate;
+      continue;
+    }
+    ++checked;
+    withCone += d.activeCones > 0;
+    unloaded += d.unloadedContacts > 0;
+    Eigen::MatrixXd dTau0, dBalance;
+    sensitivity.dataSensitivities(p, dTau0, dBalance);
+    const double forceScale = 1.0 + solution.wrenches.cwiseAbs().maxCoeff();
+    for (int which = 0; which < r.tau0.size() + 6; which += 3) {
+      const double step = 1e-4 * (which < r.tau0.size() ? 30.0 : 300.0);
+      const Eigen::VectorXd difference =
+          (solveMoved(*activeSet, r, which, step) - solveMoved(*activeSet, r, which, -step)) / (2.0 * step);
+      const Eigen::VectorXd analytic = which < r.tau0.size() ? Eigen::VectorXd(dTau0.col(which))
+                                                               : Eigen::VectorXd(dBalance.col(which - r.tau0.size()));
+      INFO("parameter " << which);
+      const double columnScale = std::max(1.0, difference.cwiseAbs().maxCoeff()) * std::max(1.0, forceScale / 300.0);
+      CHECK((analytic - difference).cwiseAbs().maxCoeff() <= 1e-6 * columnScale);
+    }
+  }
+  WARN(checked << " problems checked (" << withCone << " with an active cone, " << unloaded
+               << " with an unloaded contact), " << degenerate << " degenerate ones reported and skipped");
+  CHECK(checked >= 16);
+  CHECK(withCone >= 3);
+}
+
+TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[sensitivity]") {
+  // f*(p) = f(F*(p), p): df*/dp = ∇_F f · dF/dp + ∂f/∂p must equal ∂L/∂p. With
+  // L = f + λᵀ(B F − W) + …: ∂L/∂τ0 = ∂f/∂τ0 = 2 w∘Γ + l (the constraints do not depend on τ0)
+  // and ∂L/∂W = −λ.
+  std::mt19937 rng(307);
+  auto activeSet = makeActiveSetSolver();
+  for (int trial = 0; trial < 12; ++trial) {
+    const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult solution;
+    activeSet->solve(p, solution);
+    REQUIRE(solution.status == InnerStatus::Optimal);
+    InnerSensitivity sensitivity;
+    if (sensitivity.factorize(p, solution).degenerate()) continue;
+    Eigen::MatrixXd dTau0, dBalance;
+    sensitivity.dataSensitivities(p, dTau0, dBalance);
+    const Eigen::VectorXd gradient = p.hessian * solution.wrenches + p.gradient;  // ∇_F of what is minimised
+    const Eigen::VectorXd gamma = r.tau0 - r.wrenchToTorque * solution.wrenches;
+    const Eigen::VectorXd partialTau0 = 2.0 * r.weights.cwiseProduct(gamma) + r.linear;
+    const Eigen::VectorXd chainTau0 = dTau0.transpose() * gradient + partialTau0;
+    const Eigen::VectorXd chainBalance = dBalance.transpose() * gradient;
+    INFO("trial " << trial);
+    CHECK((chainTau0 - partialTau0).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + partialTau0.cwiseAbs().maxCoeff()));
+    const Vector6 lambda = solution.balanceMultipliers;
+    CHECK((chainBalance + lambda).cwiseAbs().maxCoeff() <= 1e-8 * (1.0 + lambda.cwiseAbs().maxCoeff()));
+    // And the value function itself, by central differences.
+    for (int which : {0, 7, static_cast<int>(r.tau0.size()) + 2}) {
+      const double step = which < r.tau0.size() ? 1e-3 : 1e-2;
+      const double difference =
+          (optimalValue(*activeSet, r, which, step) - optimalValue(*activeSet, r, which, -step)) / (2.0 * step);
+      const double expected = which < r.tau0.size() ? partialTau0[which] : -lambda[which - r.tau0.size()];
+      CHECK(difference == Approx(expected).epsilon(1e-6).margin(1e-6));
+    }
+  }
+}
+
+TEST_CASE("dense, KLU and UMFPACK factorisations give the same sensitivities", "[sensitivity]") {
+  std::mt19937 rng(311);
+  auto activeSet = makeActiveSetSolver();
+  for (int trial = 0; trial < 6; ++trial) {
+    const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult solution;
+    activeSet->solve(p, solution);
+    REQUIRE(solution.status == InnerStatus::Optimal);
+    Eigen::MatrixXd reference, referenceBalance;
+    for (KktBackend backend : {KktBackend::Dense, KktBackend::SparseKlu, KktBackend::SparseUmfpack}) {
+      SensitivitySettings settings;
+      settings.backend = backend;
+      InnerSensitivity sensitivity(settings);
+      sensitivity.factorize(p, solution);
+      Eigen::MatrixXd dTau0, dBalance;
+      sensitivity.dataSensitivities(p, dTau0, dBalance);
+      if (backend == KktBackend::Dense) {
+        reference = dTau0, referenceBalance = dBalance;
+        continue;
+      }
+      INFO(toString(backend));
+      CHECK((dTau0 - reference).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + reference.cwiseAbs().maxCoeff()));
+      CHECK((dBalance - referenceBalance).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + referenceBalance.cwiseAbs().maxCoeff()));
+    }
+  }
+}
+
+TEST_CASE("sensitivities of a result that is not optimal are refused, by name", "[sensitivity][input]") {
+  std::mt19937 rng(313);
+  test::RandomProblem r = test::randomProblem(rng, 2, 30);
+  for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};
+  r.balance << 0, 0, -300, 0, 0, 0;  // the floor would have to pull: infeasible
+  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  InnerResult result;
+  makeActiveSetSolver()->solve(p, result);
+  REQUIRE(result.status == InnerStatus::Infeasible);
+  InnerSensitivity sensitivity;
+  CHECK_THROWS_WITH(sensitivity.factorize(p, result), Catch::Matchers::Contains("infeasible") &&
+                                                          Catch::Matchers::Contains("not optimal"));
+  CHECK_THROWS_AS(parseKktBackend("mumps"), InputError);
+}
+
+TEST_CASE("an unloaded contact is held at zero and the derivatives still match differences", "[sensitivity]") {
+  // Two feet carry an admissible balance; a hand on a wall may help or not. Where the optimum
+  // leaves the hand unloaded (the cone's apex, formulation.md §7), it stays so nearby.
+  std::mt19937 rng(317);
+  InnerSettings cold;
+  cold.warmStart = false;
+  auto activeSet = makeActiveSetSolver(cold);
+  int unloadedChecked = 0;
+  for (int trial = 0; trial < 60 && unloadedChecked < 4; ++trial) {
+    const test::RandomProblem feet = test::randomProblem(rng, 2, 30);
+    const test::RandomProblem three = test::randomProblem(rng, 3, 30);
+    test::RandomProblem r = feet;
+    r.contacts.push_back(three.contacts[2]);  // the hand on the wall
+    r.wrenchToTorque.conservativeResize(Eigen::NoChange, 18);
+    r.wrenchToTorque.rightCols(6) = three.wrenchToTorque.rightCols(6);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult solution;
+    activeSet->solve(p, solution);
+    REQUIRE(solution.status == InnerStatus::Optimal);
+    InnerSensitivity sensitivity;
+    const SensitivityDiagnostics& d = sensitivity.factorize(p, solution);
+    if (d.unloadedContacts == 0 || d.degenerate()) continue;
+    ++unloadedChecked;
+    Eigen::MatrixXd dTau0, dBalance;
+    sensitivity.dataSensitivities(p, dTau0, dBalance);
+    CHECK(dTau0.bottomRows(6).topRows(5).cwiseAbs().maxCoeff() <= 1e-12);  // the hand's wrench stays zero
+    for (int which = 0; which < r.tau0.size() + 6; which += 5) {
+      const double step = 1e-4 * (which < r.tau0.size() ? 30.0 : 300.0);
+      const Eigen::VectorXd difference =
+          (solveMoved(*activeSet, r, which, step) - solveMoved(*activeSet, r, which, -step)) / (2.0 * step);
+      const Eigen::VectorXd analytic = which < r.tau0.size() ? Eigen::VectorXd(dTau0.col(which))
+                                                               : Eigen::VectorXd(dBalance.col(which - r.tau0.size()));
+      INFO("trial " << trial << ", parameter " << which << ": " << d.describe());
+      CHECK((analytic - difference).cwiseAbs().maxCoeff() <= 1e-6 * std::max(1.0, difference.cwiseAbs().maxCoeff()));
+    }
+  }
+  CHECK(unloadedChecked >= 2);
+}
