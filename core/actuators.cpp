@@ -69,6 +69,11 @@ double frictionTorque(const ActuatorParameters& actuator, double motorSpeed, dou
          actuator.dryFriction * (2.0 / std::numbers::pi) * std::atan(sharpness * motorSpeed);
 }
 
+double frictionTorqueSlope(const ActuatorParameters& actuator, double motorSpeed, double sharpness) {
+  const double x = sharpness * motorSpeed;
+  return actuator.viscousFriction + actuator.dryFriction * (2.0 / std::numbers::pi) * sharpness / (1.0 + x * x);
+}
+
 MotorPower motorPower(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
                       double acceleration) {
   const double n = actuator.gearRatio;
@@ -86,9 +91,7 @@ MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, 
   const MotorPower p = motorPower(actuator, sharpness, torque, velocity, acceleration);
   const double n = actuator.gearRatio, k = actuator.torqueConstant;
   const double motorSpeed = n * velocity;
-  const double x = sharpness * motorSpeed;
-  const double frictionSlope =
-      actuator.viscousFriction + actuator.dryFriction * (2.0 / std::numbers::pi) * sharpness / (1.0 + x * x);
+  const double frictionSlope = frictionTorqueSlope(actuator, motorSpeed, sharpness);
   const double dPdMotorTorque = motorSpeed + 2.0 * (actuator.resistance / (k * k)) * p.motorTorque;
   MotorPowerDerivatives d;
   d.power = p.power;

@@ -44,6 +44,8 @@ ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& r
 
 /// Motor-side friction torque Γ_fric at motor speed Ω (3.8).
 double frictionTorque(const ActuatorParameters& actuator, double motorSpeed, double sharpness);
+/// dΓ_fric/dΩ at motor speed Ω.
+double frictionTorqueSlope(const ActuatorParameters& actuator, double motorSpeed, double sharpness);
 
 struct MotorPower {
   double motorTorque = 0.0;  ///< Γem [N m], motor side

@@ -57,4 +57,26 @@ void wrenchMapDerivatives(const DynamicsModel& model, const DynamicsData& data, 
   }
 }
 
+void transposedWrenchMapDerivatives(const DynamicsModel& model, const DynamicsData& data, const ContactFrame& contact,
+                                    const Eigen::Ref<const Eigen::VectorXd>& g, const Vector6& lambda,
+                                    Eigen::Matrix<double, 6, Eigen::Dynamic>& dTorqueTransposed,
+                                    Eigen::Matrix<double, 6, Eigen::Dynamic>& dWorldTransposed) {
+  Matrix6 toWorld;
+  wrenchToWorld(contact, toWorld);
+  dTorqueTransposed.setZero(6, model.jointCount());
+  dWorldTransposed.setZero(6, model.jointCount());
+  const auto& edges = model.treeJoints();
+  // Σ over the whole path, then walked outboard → inboard: the part "k or inboard" is the
+  // total minus what was passed.
+  Vector6 total = Vector6::Zero();
+  for (int j = contact.bodyPosition; j > 0; j = edges[j].parent) total += g[edges[j].joint] * motionSubspace(model, data, j);
+  Vector6 outboard = Vector6::Zero();
+  for (int k = contact.bodyPosition; k > 0; k = edges[k].parent) {
+    const Vector6 axis = motionSubspace(model, data, k);
+    dTorqueTransposed.col(edges[k].joint).noalias() = -toWorld.transpose() * motionCross(axis, total - outboard);
+    dWorldTransposed.col(edges[k].joint).noalias() = -toWorld.transpose() * motionCross(axis, lambda);
+    outboard += g[edges[k].joint] * axis;
+  }
+}
+
 }  // namespace mcopt

@@ -44,4 +44,16 @@ void wrenchMapDerivatives(const DynamicsModel& model, const DynamicsData& data, 
                           const Vector6& wrench, Eigen::Matrix<double, 6, Eigen::Dynamic>& dWorld,
                           Eigen::MatrixXd& dTorque);
 
+/// Derivatives of the transposed maps w.r.t. q, for a fixed joint-space vector g (n) and a
+/// fixed world-wrench multiplier λ (6) — the (∂J1/∂p)ᵀ and (∂J2/∂p)ᵀ terms of the inner
+/// problem's sensitivity (formulation.md §8):
+///   dTorqueTransposed (6 × n) = ∂(wrenchToTorqueᵀ g)/∂q: column k = −Xᵀ (S_k × Σ_{j on the path, j = k or inboard} g_j S_j)
+///   dWorldTransposed  (6 × n) = ∂(wrenchToWorldᵀ λ)/∂q:  column k = −Xᵀ (S_k × λ)
+/// for k on the path from the reference body to C's body, zero elsewhere (X = wrenchToWorld;
+/// from ∂X/∂q_k = (S_k ×*) X and ∂S_j/∂q_k = S_k × S_j for k inboard of j).
+void transposedWrenchMapDerivatives(const DynamicsModel& model, const DynamicsData& data, const ContactFrame& contact,
+                                    const Eigen::Ref<const Eigen::VectorXd>& g, const Vector6& lambda,
+                                    Eigen::Matrix<double, 6, Eigen::Dynamic>& dTorqueTransposed,
+                                    Eigen::Matrix<double, 6, Eigen::Dynamic>& dWorldTransposed);
+
 }  // namespace mcopt

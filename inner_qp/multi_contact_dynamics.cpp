@@ -20,14 +20,52 @@ void innerObjectiveTerms(const ActuatorSet& actuators, const Eigen::Ref<const Ei
   }
 }
 
+void innerObjectiveTermDerivatives(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
+                                   Eigen::Ref<Eigen::VectorXd> linearDv, Eigen::Ref<Eigen::VectorXd> linearDa) {
+  for (Eigen::Index j = 0; j < velocity.size(); ++j) {
+    const ActuatorParameters& m = actuators.joints[static_cast<std::size_t>(j)];
+    const double N = m.gearRatio, K = m.torqueConstant, R = m.resistance;
+    linearDv[j] = 1.0 + 2.0 * R * frictionTorqueSlope(m, N * velocity[j], actuators.frictionSharpness) / (K * K);
+    linearDa[j] = 2.0 * R * m.rotorInertia / (K * K);
+  }
+}
+
+SampleProblem::SampleProblem(const DynamicsModel& model, const std::vector<ContactSurface>& contacts,
+                             const ContactProblemSettings& settings) {
+  const int n = model.jointCount(), nc = static_cast<int>(contacts.size());
+  std::vector<ContactSpec> specs;
+  for (const ContactSurface& s : contacts)
+    specs.push_back({s.name, RigidTransform{}, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0});
+  problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, 6 * nc), Eigen::VectorXd::Zero(n), Vector6::Zero(),
+                                   Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n), settings);
+  wrenchToTorque.setZero(n, 6 * nc);
+  frames.resize(static_cast<std::size_t>(nc));
+  weights.setZero(n);
+  linear.setZero(n);
+  block_.setZero(n, 6);
+}
+
+void SampleProblem::update(const DynamicsModel& model, const DynamicsData& data, const ActuatorSet& actuators,
+                           const std::vector<ContactSurface>& contacts, const Eigen::Ref<const Eigen::VectorXd>& v,
+                           const Eigen::Ref<const Eigen::VectorXd>& a) {
+  for (std::size_t i = 0; i < contacts.size(); ++i) {
+    const auto at = static_cast<int>(i);
+    frames[i] = contactFrame(model, data, contacts[i].frame, contacts[i].placement);
+    mcopt::wrenchToTorque(model, data, frames[i], block_);
+    wrenchToTorque.middleCols<6>(6 * at) = block_;
+    setContactPose(problem, at, frames[i].contactPose);
+  }
+  innerObjectiveTerms(actuators, v, a, weights, linear);
+  updateObjective(problem, wrenchToTorque, data.tau, weights, linear);
+  problem.balanceTarget = data.referenceWrench;
+}
+
 struct MultiContactEvaluator::Workspace {
   DynamicsData data;
-  ContactProblem problem;
+  SampleProblem sample;
   std::unique_ptr<InnerSolver> solver;
-  Eigen::MatrixXd wrenchToTorque;
-  WrenchToTorque block;
-  Eigen::VectorXd weights, linear;
-  explicit Workspace(const DynamicsModel& model) : data(model) {}
+  Workspace(const DynamicsModel& model, const std::vector<ContactSurface>& contacts, const ContactProblemSettings& s)
+      : data(model), sample(model, contacts, s) {}
 };
 
 MultiContactEvaluator::MultiContactEvaluator(const DynamicsModel& model, ActuatorSet actuators,
@@ -50,25 +88,14 @@ MultiContactEvaluator::MultiContactEvaluator(const DynamicsModel& model, Actuato
     if (!(actuators_.joints[j].resistance > 0.0))
       throw InputError("actuator of joint " + std::to_string(j) +
                        ": winding resistance must be positive for the inner objective (formulation.md §7)");
-  const int nc = contactCount();
-  std::vector<ContactSpec> specs;
-  for (const ContactSurface& s : contacts_)
-    specs.push_back({s.name, RigidTransform{}, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0});
   for (int t = 0; t < omp_get_max_threads(); ++t) {
-    auto w = std::make_unique<Workspace>(model);
-    w->problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, 6 * nc), Eigen::VectorXd::Zero(n),
-                                        Vector6::Zero(), Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n),
-                                        settings_.problem);
+    auto w = std::make_unique<Workspace>(model, contacts_, settings_.problem);
     w->solver = makeInnerSolver(settings_.solverName, settings_.solver);
-    w->wrenchToTorque.setZero(n, 6 * nc);
-    w->block.setZero(n, 6);
-    w->weights.setZero(n);
-    w->linear.setZero(n);
     workspaces_.push_back(std::move(w));
   }
   previous_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   // Room for the largest active set, so that copying warm starts never allocates.
-  const ContactProblem& sized = workspaces_.front()->problem;
+  const ContactProblem& sized = workspaces_.front()->sample.problem;
   for (InnerResult& r : previous_)
     r.activeSet.reserve(static_cast<std::size_t>(sized.inequality.rows()) + sized.cones.size());
 }
@@ -76,7 +103,6 @@ MultiContactEvaluator::MultiContactEvaluator(const DynamicsModel& model, Actuato
 MultiContactEvaluator::~MultiContactEvaluator() = default;
 
 void MultiContactEvaluator::evaluateSample(Workspace& w, int s, double duration, MultiContactResult& r) {
-  const int nc = contactCount();
   TrajectoryResult& m = r.motion;
   m.time[s] = samples_.time(s, duration);
   samples_.evaluate(s, controlPoints_, duration, m.q.col(s), m.v.col(s), m.a.col(s));
@@ -84,19 +110,10 @@ void MultiContactEvaluator::evaluateSample(Workspace& w, int s, double duration,
   r.tau0.col(s) = w.data.tau;
   m.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
   // The inner problem of this sample (formulation.md §5, §7): J1, the contact poses, W0.
-  for (int i = 0; i < nc; ++i) {
-    const ContactSurface& surface = contacts_[static_cast<std::size_t>(i)];
-    const ContactFrame frame = contactFrame(model_, w.data, surface.frame, surface.placement);
-    wrenchToTorque(model_, w.data, frame, w.block);
-    w.wrenchToTorque.middleCols<6>(6 * i) = w.block;
-    setContactPose(w.problem, i, frame.contactPose);
-  }
-  innerObjectiveTerms(actuators_, m.v.col(s), m.a.col(s), w.weights, w.linear);
-  updateObjective(w.problem, w.wrenchToTorque, w.data.tau, w.weights, w.linear);
-  w.problem.balanceTarget = w.data.referenceWrench;
-  if (capture_ != nullptr) (*capture_)[static_cast<std::size_t>(s)] = w.problem;
+  w.sample.update(model_, w.data, actuators_, contacts_, m.v.col(s), m.a.col(s));
+  if (capture_ != nullptr) (*capture_)[static_cast<std::size_t>(s)] = w.sample.problem;
   InnerResult& result = previous_[static_cast<std::size_t>(s)];
-  w.solver->solve(w.problem, result);
+  w.solver->solve(w.sample.problem, result);
   r.status[static_cast<std::size_t>(s)] = result.status;
   r.iterations[s] = result.iterations;
   r.kktResidual[s] = result.kktResidual;
@@ -104,7 +121,7 @@ void MultiContactEvaluator::evaluateSample(Workspace& w, int s, double duration,
   r.balanceSlack.col(s) = result.balanceSlack;
   // Γ = Γ0 − J1 F (4.8), then the motors' power with it.
   m.tau.col(s) = w.data.tau;
-  m.tau.col(s).noalias() -= w.wrenchToTorque * result.wrenches;
+  m.tau.col(s).noalias() -= w.sample.wrenchToTorque * result.wrenches;
   for (int j = 0; j < model_.jointCount(); ++j)
     m.power(j, s) = motorPower(actuators_.joints[static_cast<std::size_t>(j)], actuators_.frictionSharpness,
                                m.tau(j, s), m.v(j, s), m.a(j, s))

@@ -25,6 +25,25 @@ struct MultiContactSettings {
   std::string solverName = "active-set";  ///< active-set, slsqp or ipopt
 };
 
+/// One sample's inner problem, built from a Newton–Euler pass (formulation.md §5, §7): the
+/// contact frames, wrenchToTorque J1 (n × 6nc), the objective's per-joint terms, the balance
+/// at W0. Sized once; update() allocates nothing.
+struct SampleProblem {
+  SampleProblem(const DynamicsModel& model, const std::vector<ContactSurface>& contacts,
+                const ContactProblemSettings& settings);
+  /// `data` holds the inverse dynamics of (q, v, a) (Γ0, W0 and the kinematics).
+  void update(const DynamicsModel& model, const DynamicsData& data, const ActuatorSet& actuators,
+              const std::vector<ContactSurface>& contacts, const Eigen::Ref<const Eigen::VectorXd>& v,
+              const Eigen::Ref<const Eigen::VectorXd>& a);
+
+  ContactProblem problem;
+  Eigen::MatrixXd wrenchToTorque;      ///< J1
+  std::vector<ContactFrame> frames;    ///< the contacts' frames at this sample
+  Eigen::VectorXd weights, linear;     ///< w, l of the objective
+ private:
+  WrenchToTorque block_;
+};
+
 struct MultiContactResult {
   TrajectoryResult motion;           ///< time, q, q̇, q̈; tau = Γ with the chosen wrenches; power and energy from it
   Eigen::MatrixXd tau0;              ///< Γ0: torques with the reference body alone carrying the robot, n × N
@@ -78,5 +97,8 @@ class MultiContactEvaluator {
 void innerObjectiveTerms(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
                          const Eigen::Ref<const Eigen::VectorXd>& acceleration, Eigen::Ref<Eigen::VectorXd> weights,
                          Eigen::Ref<Eigen::VectorXd> linear);
+/// ∂l/∂q̇ = 1 + 2 R Γ_fric'(N q̇) / K² and ∂l/∂q̈ = 2 R I_m / K², per joint (w is constant).
+void innerObjectiveTermDerivatives(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
+                                   Eigen::Ref<Eigen::VectorXd> linearDv, Eigen::Ref<Eigen::VectorXd> linearDa);
 
 }  // namespace mcopt

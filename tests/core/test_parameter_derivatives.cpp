@@ -174,6 +174,27 @@ TEST_CASE("wrench maps: J1 is the contact frame Jacobian transposed, derivatives
     const Eigen::MatrixXd fdWorld = fd.bottomRows(6);
     CHECK(test::scaledError(dTorque, fdTorque) <= 1e-6);
     CHECK(test::scaledError(dWorld, fdWorld) <= 1e-6);
+
+    // The transposed maps with a fixed joint vector g and world multiplier λ (the inner
+    // problem's sensitivity needs both).
+    const Eigen::VectorXd g = test::randomVector(rng, n, 10.0);
+    const Vector6 lambda = test::randomVector(rng, 6, 3.0);
+    Eigen::Matrix<double, 6, Eigen::Dynamic> dTorqueT, dWorldT;
+    transposedWrenchMapDerivatives(model, data, contact, g, lambda, dTorqueT, dWorldT);
+    const Eigen::MatrixXd fdTransposed = test::centralDifferences(q, 1e-6, [&] {
+      forwardKinematics(model, data, q);
+      const ContactFrame moved = contactFrame(model, data, surface.frame, surface.placement);
+      Matrix6 w;
+      WrenchToTorque t;
+      wrenchToWorld(moved, w);
+      wrenchToTorque(model, data, moved, t);
+      Eigen::VectorXd stacked(12);
+      stacked << t.transpose() * g, w.transpose() * lambda;
+      return stacked;
+    });
+    forwardKinematics(model, data, q);
+    CHECK(test::scaledError(dTorqueT, fdTransposed.topRows(6)) <= 1e-6);
+    CHECK(test::scaledError(dWorldT, fdTransposed.bottomRows(6)) <= 1e-6);
   }
 }
 
