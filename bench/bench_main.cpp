@@ -7,6 +7,7 @@
 namespace mcopt::bench {
 void registerDynamicsBenchmarks();
 void registerInnerBenchmarks();
+void registerSensitivityBenchmarks();
 }
 
 int main(int argc, char** argv) {
@@ -15,6 +16,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
   mcopt::bench::registerDynamicsBenchmarks();
   mcopt::bench::registerInnerBenchmarks();
+  mcopt::bench::registerSensitivityBenchmarks();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -54,8 +54,16 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
   SolverTally slsqpTally, ipoptTally;
   int problems = 0, unloaded = 0;
   double worstKkt = 0.0;
+  // Under the sanitizers (ASan's allocator behind every Ipopt and MUMPS allocation: 25 s
+  // become more than 10 minutes) a fifth of the catalogue runs; the acceptance count is the
+  // Release build's.
+#ifdef MCOPT_UNDER_SANITIZERS
+  constexpr int kPerContactCount = 67;
+#else
+  constexpr int kPerContactCount = 334;
+#endif
   for (int nc : {2, 3, 4}) {
-    for (int trial = 0; trial < 334; ++trial, ++problems) {
+    for (int trial = 0; trial < kPerContactCount; ++trial, ++problems) {
       const RandomProblem r = randomProblem(rng, nc);
       const ContactProblem p = assemble(r, ContactModel::Report);
       InnerResult reference;
@@ -89,7 +97,7 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
              << slsqpTally.optimal << ", at the same optimum " << slsqpTally.sameOptimum << "; Ipopt optimal "
              << ipoptTally.optimal << ", at the same optimum " << ipoptTally.sameOptimum);
   // The degenerate case the method is built for is exercised, not avoided.
-  CHECK(unloaded >= 20);
+  CHECK(unloaded >= problems / 50);  // 43 of 1002 measured
   // The third-party solvers fail to certify a few per cent (unloaded contacts, where the
   // smooth cone's curvature is 1/δ, and Ipopt's iteration limit); they must still reach the
   // same optimum on the great majority (measured: SLSQP 1001, Ipopt 969 of 1002).
