@@ -94,7 +94,9 @@ void MultiContactGradientEvaluator::evaluateSample(Workspace& w, int s, double d
   }
   w.dF.setZero();
   if (inner.status == InnerStatus::Optimal) {
-    w.degenerate += w.sensitivity.factorize(w.sample.problem, inner).degenerate();
+    const SensitivityDiagnostics& diagnostics = w.sensitivity.factorize(w.sample.problem, inner);
+    grad.diagnostics[static_cast<std::size_t>(s)] = diagnostics;
+    w.degenerate += diagnostics.degenerate();
     const auto& weights = w.sample.weights;
     w.g = 2.0 * weights.cwiseProduct(motion.tau.col(s)) + w.sample.linear;
     innerObjectiveTermDerivatives(actuators_, motion.v.col(s), w.linearDv, w.linearDa);
@@ -115,6 +117,7 @@ void MultiContactGradientEvaluator::evaluateSample(Workspace& w, int s, double d
     w.balance.rightCols(n) = -d.dwrenchDa;
     w.sensitivity.solve(w.stationarity, w.balance, w.dF);
   } else {
+    grad.diagnostics[static_cast<std::size_t>(s)] = SensitivityDiagnostics{};
     ++w.withoutDerivative;
   }
   // dΓ/dx = dΓ0/dx − (∂J1/∂x) F − J1 dF/dx  (4.8)
@@ -181,6 +184,7 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   }
   grad.torqueAndEnergy.torque.resize(static_cast<std::size_t>(count));
   grad.wrenches.resize(static_cast<std::size_t>(count));
+  grad.diagnostics.resize(static_cast<std::size_t>(count));
   samples_.parametrization().controlPoints(parameters, controlPoints_);
   for (auto& w : workspaces_) {
     w->energyGradient.setZero(parameterCount);

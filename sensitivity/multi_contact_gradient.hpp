@@ -34,6 +34,7 @@ struct SampleWrenchJacobian {
 struct MultiContactGradient {
   TrajectoryGradient torqueAndEnergy;          ///< ∂E/∂x, ∂E/∂T and per-sample ∂Γ/∂x, ∂Γ/∂T with the inner wrenches
   std::vector<SampleWrenchJacobian> wrenches;  ///< per sample, dF/dx and dF/dT
+  std::vector<SensitivityDiagnostics> diagnostics;  ///< per sample (default-constructed where there is no derivative)
   int degenerateSamples = 0;                   ///< one-sided derivatives (see SensitivityDiagnostics)
   int samplesWithoutDerivative = 0;            ///< inner result not optimal: dF taken as zero
 };

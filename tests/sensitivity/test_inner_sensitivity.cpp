@@ -199,3 +199,46 @@ TEST_CASE("an unloaded contact is held at zero and the derivatives still match d
   }
   CHECK(unloadedChecked >= 2);
 }
+
+TEST_CASE("sensitivities from each solver's own result agree with the active-set method's", "[sensitivity][solvers]") {
+  // The active-set sensitivities are the ones checked against differences above; SLSQP's and
+  // Ipopt's results are certified to a KKT residual of 1e-6 only, which bounds the agreement.
+  std::mt19937 rng(331);
+  auto activeSet = makeActiveSetSolver();
+  double worst[2] = {0.0, 0.0};
+  int compared[2] = {0, 0};
+  for (int trial = 0; trial < 15; ++trial) {
+    const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult reference;
+    activeSet->solve(p, reference);
+    REQUIRE(reference.status == InnerStatus::Optimal);
+    InnerSensitivity referenceSensitivity;
+    if (referenceSensitivity.factorize(p, reference).degenerate()) continue;
+    Eigen::MatrixXd referenceTau0, referenceBalance;
+    referenceSensitivity.dataSensitivities(p, referenceTau0, referenceBalance);
+    int index = 0;
+    for (auto make : {makeSlsqpSolver, makeIpoptSolver}) {
+      auto solver = make(InnerSettings{});
+      InnerResult result;
+      solver->solve(p, result);
+      const int which = index++;
+      if (result.status != InnerStatus::Optimal) continue;
+      InnerSensitivity sensitivity;
+      if (sensitivity.factorize(p, result).degenerate()) continue;
+      Eigen::MatrixXd dTau0, dBalance;
+      sensitivity.dataSensitivities(p, dTau0, dBalance);
+      const double error = std::max((dTau0 - referenceTau0).cwiseAbs().maxCoeff() / (1.0 + referenceTau0.cwiseAbs().maxCoeff()),
+                                    (dBalance - referenceBalance).cwiseAbs().maxCoeff() / (1.0 + referenceBalance.cwiseAbs().maxCoeff()));
+      worst[which] = std::max(worst[which], error);
+      ++compared[which];
+      INFO(solver->name() << ", trial " << trial);
+      CHECK(error <= 1e-6);
+    }
+  }
+  WARN("worst relative difference to the active-set sensitivities: SLSQP " << worst[0] << " (" << compared[0]
+                                                                            << " problems), Ipopt " << worst[1] << " ("
+                                                                            << compared[1] << ")");
+  CHECK(compared[0] >= 8);
+  CHECK(compared[1] >= 8);
+}

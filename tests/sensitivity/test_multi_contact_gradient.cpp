@@ -122,3 +122,70 @@ TEST_CASE("multi-contact torque, wrench and energy gradients match central diffe
     }
   }
 }
+
+#ifdef MCOPT_SHARED_DIR
+TEST_CASE("multi-contact gradients on the ../shared robots match central differences", "[sensitivity][gradient][shared]") {
+  // Both soles in contact (a rectangle about each sole frame), generic motors, a motion moving
+  // every joint a little. Samples that are not optimal or degenerate (one-sided derivatives)
+  // are reported, not compared; the energy is compared when every sample has a derivative.
+  std::mt19937 rng(409);
+  for (const auto& named : test::sharedRobots()) {
+    const RobotModel robot = test::load(named);
+    const DynamicsModel model(robot, named.soles[0]);
+    ActuatorSet actuators = defaultActuators(robot);
+    for (ActuatorParameters& m : actuators.joints)
+      m.gearRatio = 100.0, m.torqueConstant = 0.1, m.resistance = 1.0, m.rotorInertia = 1e-5, m.viscousFriction = 1e-4,
+      m.dryFriction = 0.0;
+    std::vector<ContactSurface> contacts;
+    for (const std::string& sole : named.soles) {
+      ContactSurface s;
+      s.name = sole;
+      s.frame = robot.frameIndex(sole);
+      s.xMin = -0.08, s.xMax = 0.1, s.yMin = -0.05, s.yMax = 0.05, s.friction = 0.8;
+      contacts.push_back(s);
+    }
+    const MotionParametrization parametrization(robot.jointCount());
+    const int samples = 8;
+    MultiContactGradientEvaluator gradientEvaluator(model, actuators, SampledTrajectory(parametrization, samples), contacts);
+    MultiContactEvaluator valueEvaluator(model, actuators, SampledTrajectory(parametrization, samples), contacts);
+    const Eigen::VectorXd x = test::randomVector(rng, parametrization.parameterCount(), 0.05);
+    MultiContactResult result;
+    MultiContactGradient gradient;
+    gradientEvaluator.evaluate(x, 1.2, result, gradient);
+    int compared = 0;
+    std::uniform_int_distribution<int> pick(0, parametrization.parameterCount() - 1);
+    for (int trial = 0; trial < 4; ++trial) {
+      const int parameter = pick(rng);
+      auto difference = [&](double h, MultiContactResult& plus, MultiContactResult& minus) {
+        Eigen::VectorXd y = x;
+        y[parameter] += h;
+        valueEvaluator.evaluate(y, 1.2, plus);
+        y[parameter] = x[parameter] - h;
+        valueEvaluator.evaluate(y, 1.2, minus);
+      };
+      MultiContactResult plus, minus, plus2, minus2;
+      difference(1e-5, plus, minus);
+      difference(2e-5, plus2, minus2);
+      const Eigen::MatrixXd dTau = (4.0 * (plus.motion.tau - minus.motion.tau) / 2e-5 -
+                                    (plus2.motion.tau - minus2.motion.tau) / 4e-5) / 3.0;
+      for (int s = 0; s < samples; ++s) {
+        const auto k = static_cast<std::size_t>(s);
+        const bool usable = result.status[k] == InnerStatus::Optimal && !gradient.diagnostics[k].degenerate() &&
+                            plus.status[k] == InnerStatus::Optimal && minus.status[k] == InnerStatus::Optimal &&
+                            plus2.status[k] == InnerStatus::Optimal && minus2.status[k] == InnerStatus::Optimal;
+        if (!usable) continue;
+        const SampleTorqueJacobian& torque = gradient.torqueAndEnergy.torque[k];
+        Eigen::VectorXd analytic = Eigen::VectorXd::Zero(robot.jointCount());
+        for (Eigen::Index c = 0; c < torque.parameters.size(); ++c)
+          if (torque.parameters[c] == parameter) analytic = torque.dtauDx.col(c);
+        INFO(named.name << ", parameter " << parameter << ", sample " << s << ": " << gradient.diagnostics[k].describe());
+        CHECK((analytic - dTau.col(s)).cwiseAbs().maxCoeff() <= 1e-6 * (1.0 + dTau.col(s).cwiseAbs().maxCoeff()));
+        ++compared;
+      }
+    }
+    WARN(named.name << ": " << compared << " sample torque columns compared; " << result.infeasibleSamples
+                    << " infeasible, " << gradient.degenerateSamples << " degenerate samples");
+    CHECK(compared >= 8);
+  }
+}
+#endif
