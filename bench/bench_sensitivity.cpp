@@ -4,6 +4,8 @@
 // sample with the dense (Eigen LU) or SuiteSparse (KLU, UMFPACK) path. Threads: OMP_NUM_THREADS.
 #include <benchmark/benchmark.h>
 
+#include <tuple>
+
 #include "bench/hrp2_motion.hpp"
 #include "sensitivity/multi_contact_gradient.hpp"
 
@@ -11,10 +13,11 @@ namespace mcopt::bench {
 
 namespace {
 
-void bilevelGradient(benchmark::State& state, int contacts, KktBackend backend) {
+void bilevelGradient(benchmark::State& state, int contacts, KktBackend backend, KktLayout layout) {
   const Hrp2Motion motion;
   SensitivitySettings sensitivity;
   sensitivity.backend = backend;
+  sensitivity.layout = layout;
   MultiContactGradientEvaluator evaluator(motion.model, loadActuators(kHrp2 / "actuators.yaml", motion.robot),
                                           SampledTrajectory(motion.parametrization, 100), motion.contacts(contacts), {},
                                           sensitivity);
@@ -34,14 +37,19 @@ void bilevelGradient(benchmark::State& state, int contacts, KktBackend backend) 
 }  // namespace
 
 void registerSensitivityBenchmarks() {
-  for (KktBackend backend : {KktBackend::Dense, KktBackend::SparseKlu, KktBackend::SparseUmfpack}) {
-    const std::string suffix = std::string("/hrp2/") + toString(backend);
-    benchmark::RegisterBenchmark(("BilevelGradient/TwoContacts100" + suffix).c_str(), bilevelGradient, 2, backend)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
-    benchmark::RegisterBenchmark(("BilevelGradient/ThreeContacts100" + suffix).c_str(), bilevelGradient, 3, backend)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+  // Per-sample factorisation with each backend, and the all-samples block-diagonal one ("-all").
+  const std::vector<std::tuple<std::string, KktBackend, KktLayout>> variants = {
+      {"dense", KktBackend::Dense, KktLayout::PerSample},
+      {"klu", KktBackend::SparseKlu, KktLayout::PerSample},
+      {"umfpack", KktBackend::SparseUmfpack, KktLayout::PerSample},
+      {"klu-all", KktBackend::SparseKlu, KktLayout::AllSamples},
+      {"umfpack-all", KktBackend::SparseUmfpack, KktLayout::AllSamples}};
+  for (const auto& [name, backend, layout] : variants) {
+    for (const auto& [label, contacts] : {std::pair{"TwoContacts100", 2}, std::pair{"ThreeContacts100", 3}})
+      benchmark::RegisterBenchmark(("BilevelGradient/" + std::string(label) + "/hrp2/" + name).c_str(), bilevelGradient,
+                                   contacts, backend, layout)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   }
 }
 

@@ -50,6 +50,8 @@ struct InnerSensitivity::Impl {
   Eigen::UmfPackLU<Eigen::SparseMatrix<double>> umfpack;
   KktBackend used = KktBackend::Dense;
   Eigen::MatrixXd weightedWrenchToTorque;  ///< diag(w) J1 of the factorised problem, for dataSensitivities
+  Eigen::MatrixXd lagrangianHessian, rhs, solution;
+  std::vector<char> active;
 };
 
 InnerSensitivity::InnerSensitivity(SensitivitySettings settings) : impl_(std::make_unique<Impl>()) {
@@ -79,20 +81,39 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   const double strict = m.settings.strictMultiplier * scale;
   const double forceScale = 1.0 + F.cwiseAbs().maxCoeff();
   const auto rowCount = static_cast<int>(p.inequality.rows());
+  const auto coneCount = static_cast<int>(p.cones.size());
   const int perContact = rowCount / nc;  // assembly order: each contact's rows together, fz_min first
-  std::vector<char> active(static_cast<std::size_t>(rowCount + static_cast<int>(p.cones.size())), 0);
-  for (int a : r.activeSet) active[static_cast<std::size_t>(a)] = 1;
+  m.active.assign(static_cast<std::size_t>(rowCount + coneCount), 0);
+  for (int a : r.activeSet) m.active[static_cast<std::size_t>(a)] = 1;
 
-  Eigen::MatrixXd lagrangianHessian = p.hessian;
-  std::vector<Eigen::RowVectorXd> rows;  // the system's constraint rows beyond the balance
+  // Fixed size per problem shape, so that repeated factorisations reuse every buffer: one
+  // slot per linear row and cone; the slots not used (inactive constraints) are decoupled
+  // identity rows, dμ = 0, which changes nothing. An unloaded contact's pins (≤ 6) take the
+  // slots of its own rows and cone (≥ 6 in every contact model).
+  const int size = n + 6 + rowCount + coneCount;
+  m.kkt.setZero(size, size);
+  m.lagrangianHessian = p.hessian;
+  m.kkt.block(n, 0, 6, n) = p.balance;
+  m.kkt.block(0, n, n, 6) = p.balance.transpose();
+  int next = n + 6;
+  auto addRow = [&](const auto& row) {
+    m.kkt.block(next, 0, 1, n) = row;
+    m.kkt.block(0, next, n, 1) = row.transpose();
+    ++next;
+  };
+  auto addUnit = [&](int column) {
+    m.kkt(next, column) = 1.0;
+    m.kkt(column, next) = 1.0;
+    ++next;
+  };
   for (int i = 0; i < nc; ++i) {
     const int fzRow = perContact * i;
     const double fz = F[6 * i + 2];
     const int cone = p.cones.empty() ? -1 : i;  // report model: cone i belongs to contact i
     // Held at zero by its fz_min row or by its cone's apex (the active-set method certifies
     // an unloaded contact through the cone's planes, whose multipliers make y_z).
-    const bool apex = cone >= 0 && active[static_cast<std::size_t>(rowCount + cone)];
-    if ((active[static_cast<std::size_t>(fzRow)] || apex) && std::abs(fz) <= m.settings.unloadedForce * forceScale) {
+    const bool apex = cone >= 0 && m.active[static_cast<std::size_t>(rowCount + cone)];
+    if ((m.active[static_cast<std::size_t>(fzRow)] || apex) && std::abs(fz) <= m.settings.unloadedForce * forceScale) {
       // Unloaded: held at zero wrench while its pushing multiplier is positive.
       ++m.diagnostics.unloadedContacts;
       double push = r.inequalityMultipliers[fzRow];
@@ -100,53 +121,39 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       if (!(push > strict)) ++m.diagnostics.weaklyActive;
       bool yawHeld = false;
       for (int k = fzRow; k < fzRow + perContact; ++k) yawHeld |= p.inequality(k, 6 * i + 5) != 0.0;
-      for (int component = 0; component < (yawHeld ? 6 : 5); ++component) {
-        Eigen::RowVectorXd unit = Eigen::RowVectorXd::Zero(n);
-        unit[6 * i + component] = 1.0;
-        rows.push_back(unit);
-      }
+      for (int component = 0; component < (yawHeld ? 6 : 5); ++component) addUnit(6 * i + component);
       continue;
     }
     for (int k = fzRow; k < fzRow + perContact; ++k) {
-      if (!active[static_cast<std::size_t>(k)]) continue;
+      if (!m.active[static_cast<std::size_t>(k)]) continue;
       if (r.inequalityMultipliers[k] > strict) {
-        rows.push_back(p.inequality.row(k));
+        addRow(p.inequality.row(k));
         ++m.diagnostics.activeRows;
       } else {
         ++m.diagnostics.weaklyActive;
       }
     }
-    if (cone >= 0 && active[static_cast<std::size_t>(rowCount + cone)]) {
+    if (cone >= 0 && m.active[static_cast<std::size_t>(rowCount + cone)]) {
       const FrictionCone& c = p.cones[static_cast<std::size_t>(cone)];
       const double nu = r.coneMultipliers[3 * cone + 2] / c.friction;
       const Eigen::Vector2d shear = F.segment<2>(c.index);
       const double norm = shear.norm();
       if (nu > strict && norm > 0.0) {
         const Eigen::Vector2d u = shear / norm;
-        Eigen::RowVectorXd gradient = Eigen::RowVectorXd::Zero(n);
-        gradient[c.index] = u.x();
-        gradient[c.index + 1] = u.y();
-        gradient[c.index + 2] = -c.friction;
-        rows.push_back(gradient);
-        lagrangianHessian.block<2, 2>(c.index, c.index) += (nu / norm) * (Eigen::Matrix2d::Identity() - u * u.transpose());
+        m.kkt(next, c.index) = m.kkt(c.index, next) = u.x();
+        m.kkt(next, c.index + 1) = m.kkt(c.index + 1, next) = u.y();
+        m.kkt(next, c.index + 2) = m.kkt(c.index + 2, next) = -c.friction;
+        ++next;
+        m.lagrangianHessian.block<2, 2>(c.index, c.index) += (nu / norm) * (Eigen::Matrix2d::Identity() - u * u.transpose());
         ++m.diagnostics.activeCones;
       } else {
         ++m.diagnostics.weaklyActive;
       }
     }
   }
-
-  const int size = n + 6 + static_cast<int>(rows.size());
+  m.kkt.topLeftCorner(n, n) = m.lagrangianHessian;
+  for (int slot = next; slot < size; ++slot) m.kkt(slot, slot) = 1.0;  // unused slots: dμ = 0
   m.diagnostics.size = size;
-  m.kkt.setZero(size, size);
-  m.kkt.topLeftCorner(n, n) = lagrangianHessian;
-  m.kkt.block(n, 0, 6, n) = p.balance;
-  m.kkt.block(0, n, n, 6) = p.balance.transpose();
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const int at = n + 6 + static_cast<int>(k);
-    m.kkt.block(at, 0, 1, n) = rows[k];
-    m.kkt.block(0, at, n, 1) = rows[k].transpose();
-  }
 
   // Dense LU always gives the condition estimate; a near-singular system (dependent active
   // rows, whose multipliers are then not unique while dF is) is solved in the least-norm sense.
@@ -168,18 +175,33 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   return m.diagnostics;
 }
 
+const Eigen::MatrixXd& InnerSensitivity::kktMatrix() const { return impl_->kkt; }
+
+void InnerSensitivity::rightHandSide(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity,
+                                     const Eigen::Ref<const Eigen::MatrixXd>& dBalance, Eigen::MatrixXd& rhs) const {
+  const int n = impl_->variables, size = impl_->diagnostics.size;
+  if (size == 0) throw InputError("sensitivity: right-hand side before factorize");
+  rhs.setZero(size, dStationarity.cols());
+  rhs.topRows(n) = -dStationarity;
+  rhs.middleRows(n, 6) = -dBalance;
+}
+
 void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity,
                              const Eigen::Ref<const Eigen::MatrixXd>& dBalance, Eigen::MatrixXd& dWrenches,
                              Eigen::MatrixXd* dBalanceMultipliers) const {
-  const Impl& m = *impl_;
+  Impl& m = *impl_;
   const int n = m.variables, size = m.diagnostics.size;
   if (size == 0) throw InputError("sensitivity: solve before factorize");
   if (dStationarity.rows() != n || dBalance.rows() != 6 || dStationarity.cols() != dBalance.cols())
     throw InputError("sensitivity: right-hand sides must be 6nc × m and 6 × m");
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size, dStationarity.cols());
+  // Buffers reused from call to call (allocation-free for the same shapes: the per-sample
+  // path of MultiContactGradientEvaluator).
+  Eigen::MatrixXd& rhs = impl_->rhs;
+  Eigen::MatrixXd& solution = impl_->solution;
+  rhs.setZero(size, dStationarity.cols());
   rhs.topRows(n) = -dStationarity;
   rhs.middleRows(n, 6) = -dBalance;
-  Eigen::MatrixXd solution;
+  solution.resize(size, dStationarity.cols());
   switch (m.used) {
     case KktBackend::SparseKlu: solution = m.klu.solve(rhs); break;
     case KktBackend::SparseUmfpack: solution = m.umfpack.solve(rhs); break;
@@ -187,7 +209,7 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
       if (m.useRankRevealing)
         solution = m.rankRevealing.solve(rhs);
       else
-        solution = m.lu.solve(rhs);
+        solution.noalias() = m.lu.solve(rhs);
       break;
   }
   dWrenches = solution.topRows(n);

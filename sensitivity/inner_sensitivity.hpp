@@ -36,8 +36,13 @@ const char* toString(KktBackend backend);
 /// "dense", "klu" or "umfpack"; throws InputError otherwise.
 KktBackend parseKktBackend(const std::string& name);
 
+/// Whole motions (MultiContactGradientEvaluator): one KKT system per sample, or all samples'
+/// systems as one block-diagonal sparse matrix factorised once (sparse backends only).
+enum class KktLayout { PerSample, AllSamples };
+
 struct SensitivitySettings {
   KktBackend backend = KktBackend::Dense;
+  KktLayout layout = KktLayout::PerSample;
   /// A constraint whose multiplier is at most this fraction of the data's scale is weakly
   /// active: left out of the system and counted as degenerate.
   double strictMultiplier = 1e-9;
@@ -81,6 +86,12 @@ class InnerSensitivity {
   /// ∂(B F − W)/∂W = −1.
   void dataSensitivities(const ContactProblem& problem, Eigen::MatrixXd& dWrenchesDtau0,
                          Eigen::MatrixXd& dWrenchesDbalance) const;
+
+  /// For factorising many samples' systems together: the assembled KKT matrix (size × size)
+  /// and the right-hand side −[dStationarity; dBalance; 0] of solve().
+  const Eigen::MatrixXd& kktMatrix() const;
+  void rightHandSide(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity,
+                     const Eigen::Ref<const Eigen::MatrixXd>& dBalance, Eigen::MatrixXd& rhs) const;
 
  private:
   struct Impl;

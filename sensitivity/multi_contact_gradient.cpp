@@ -2,6 +2,10 @@
 
 #include <omp.h>
 
+#include <Eigen/KLUSupport>
+#include <Eigen/SparseCore>
+#include <Eigen/UmfPackSupport>
+
 #include "core/errors.hpp"
 
 namespace mcopt {
@@ -16,7 +20,7 @@ struct MultiContactGradientEvaluator::Workspace {
     dJ1Fdq.setZero(n, n), dTorque.setZero(n, n);
     dBFdq.setZero(6, n), dWorld.setZero(6, n), dTorqueT.setZero(6, n), dWorldT.setZero(6, n);
     stationarity.setZero(6 * nc, 3 * n), balance.setZero(6, 3 * n), dF.setZero(6 * nc, 3 * n);
-    dGammaDq.setZero(n, n), dGammaDv.setZero(n, n), dGammaDa.setZero(n, n);
+    dGammaDq.setZero(n, n), dGammaDv.setZero(n, n), dGammaDa.setZero(n, n), scaled.setZero(n, n);
     energyGradient.setZero(0), powerTorque.setZero(n), rowQ.setZero(n), rowV.setZero(n), rowA.setZero(n);
   }
   DynamicsData data;
@@ -28,7 +32,7 @@ struct MultiContactGradientEvaluator::Workspace {
   Eigen::MatrixXd dJ1Fdq, dTorque;
   Eigen::Matrix<double, 6, Eigen::Dynamic> dBFdq, dWorld, dTorqueT, dWorldT;
   Eigen::MatrixXd stationarity, balance, dF;
-  Eigen::MatrixXd dGammaDq, dGammaDv, dGammaDa;
+  Eigen::MatrixXd dGammaDq, dGammaDv, dGammaDa, scaled;
   Eigen::VectorXd energyGradient, powerTorque, rowQ, rowV, rowA;
   double energyDT = 0.0;
   int degenerate = 0, withoutDerivative = 0;
@@ -56,14 +60,17 @@ MultiContactGradientEvaluator::MultiContactGradientEvaluator(const DynamicsModel
   for (int t = 0; t < omp_get_max_threads(); ++t)
     workspaces_.push_back(std::make_unique<Workspace>(model, contacts_, settings_, sensitivitySettings_));
   previous_.resize(static_cast<std::size_t>(samples_.sampleCount()));
+  store_.resize(static_cast<std::size_t>(samples_.sampleCount()));
+  sampleKkt_.resize(static_cast<std::size_t>(samples_.sampleCount()));
+  if (sensitivitySettings_.layout == KktLayout::AllSamples && sensitivitySettings_.backend == KktBackend::Dense)
+    throw InputError("the all-samples KKT layout needs a sparse backend (klu or umfpack)");
 }
 
 MultiContactGradientEvaluator::~MultiContactGradientEvaluator() = default;
 
-void MultiContactGradientEvaluator::evaluateSample(Workspace& w, int s, double duration, MultiContactResult& r,
-                                                   MultiContactGradient& grad) {
+void MultiContactGradientEvaluator::prepareSample(Workspace& w, int s, double duration, MultiContactResult& r,
+                                                  MultiContactGradient& grad) {
   const int n = model_.jointCount(), nc = static_cast<int>(contacts_.size());
-  const int count = samples_.sampleCount(), m = samples_.parametrization().parametersPerJoint();
   TrajectoryResult& motion = r.motion;
   motion.time[s] = samples_.time(s, duration);
   samples_.evaluate(s, controlPoints_, duration, motion.q.col(s), motion.v.col(s), motion.a.col(s));
@@ -92,7 +99,13 @@ void MultiContactGradientEvaluator::evaluateSample(Workspace& w, int s, double d
     w.dJ1Fdq += w.dTorque;
     w.dBFdq += w.dWorld;
   }
-  w.dF.setZero();
+  SampleStore& store = store_[static_cast<std::size_t>(s)];
+  store.wrenchToTorque = J1;
+  store.fixedWrenchQ = d.dtauDq - w.dJ1Fdq;
+  store.fixedWrenchV = d.dtauDv;
+  store.fixedWrenchA = d.dtauDa;
+  store.dF.setZero(6 * nc, 3 * n);
+  store.hasDerivative = inner.status == InnerStatus::Optimal;
   if (inner.status == InnerStatus::Optimal) {
     const SensitivityDiagnostics& diagnostics = w.sensitivity.factorize(w.sample.problem, inner);
     grad.diagnostics[static_cast<std::size_t>(s)] = diagnostics;
@@ -106,36 +119,94 @@ void MultiContactGradientEvaluator::evaluateSample(Workspace& w, int s, double d
       w.stationarity.block(6 * i, 0, 6, n) = w.dWorldT - w.dTorqueT;
     }
     // −J1ᵀ 2 diag(w) (∂Γ/∂x at fixed F) − J1ᵀ diag(∂l/∂x)
-    w.dGammaDq = d.dtauDq - w.dJ1Fdq;  // ∂Γ/∂q at fixed F (scratch)
-    w.stationarity.leftCols(n).noalias() -= 2.0 * J1.transpose() * (weights.asDiagonal() * w.dGammaDq);
-    w.stationarity.middleCols(n, n).noalias() = -2.0 * J1.transpose() * (weights.asDiagonal() * d.dtauDv);
-    w.stationarity.middleCols(n, n).noalias() -= J1.transpose() * w.linearDv.asDiagonal();
-    w.stationarity.rightCols(n).noalias() = -2.0 * J1.transpose() * (weights.asDiagonal() * d.dtauDa);
-    w.stationarity.rightCols(n).noalias() -= J1.transpose() * w.linearDa.asDiagonal();
+    // (scaled: 2 diag(w) times ∂Γ/∂x at fixed F, in a preallocated buffer: no temporaries)
+    w.scaled.noalias() = 2.0 * weights.asDiagonal() * (d.dtauDq - w.dJ1Fdq);
+    w.stationarity.leftCols(n).noalias() -= J1.transpose() * w.scaled;
+    w.scaled.noalias() = 2.0 * weights.asDiagonal() * d.dtauDv;
+    w.scaled.diagonal() += w.linearDv;
+    w.stationarity.middleCols(n, n).noalias() = -J1.transpose() * w.scaled;
+    w.scaled.noalias() = 2.0 * weights.asDiagonal() * d.dtauDa;
+    w.scaled.diagonal() += w.linearDa;
+    w.stationarity.rightCols(n).noalias() = -J1.transpose() * w.scaled;
     w.balance.leftCols(n) = w.dBFdq - d.dwrenchDq;
     w.balance.middleCols(n, n) = -d.dwrenchDv;
     w.balance.rightCols(n) = -d.dwrenchDa;
-    w.sensitivity.solve(w.stationarity, w.balance, w.dF);
+    if (sensitivitySettings_.layout == KktLayout::AllSamples) {
+      sampleKkt_[static_cast<std::size_t>(s)] = w.sensitivity.kktMatrix();
+      w.sensitivity.rightHandSide(w.stationarity, w.balance, store.rhs);
+    } else {
+      w.sensitivity.solve(w.stationarity, w.balance, store.dF);
+    }
   } else {
+    sampleKkt_[static_cast<std::size_t>(s)].resize(0, 0);
     grad.diagnostics[static_cast<std::size_t>(s)] = SensitivityDiagnostics{};
     ++w.withoutDerivative;
   }
+}
+
+void MultiContactGradientEvaluator::solveAllSamples() {
+  // One block-diagonal matrix of every sample's KKT system, factorised once; the right-hand
+  // sides share their 3n columns (the blocks do not interact).
+  const int count = samples_.sampleCount(), n = model_.jointCount();
+  std::vector<Eigen::Triplet<double>> entries;
+  int size = 0;
+  std::vector<int> offset(static_cast<std::size_t>(count), -1);
+  for (int s = 0; s < count; ++s) {
+    const Eigen::MatrixXd& K = sampleKkt_[static_cast<std::size_t>(s)];
+    if (!store_[static_cast<std::size_t>(s)].hasDerivative || K.size() == 0) continue;
+    offset[static_cast<std::size_t>(s)] = size;
+    for (Eigen::Index c = 0; c < K.cols(); ++c)
+      for (Eigen::Index r = 0; r < K.rows(); ++r)
+        if (K(r, c) != 0.0) entries.emplace_back(size + static_cast<int>(r), size + static_cast<int>(c), K(r, c));
+    size += static_cast<int>(K.rows());
+  }
+  if (size == 0) return;
+  Eigen::SparseMatrix<double> blocks(size, size);
+  blocks.setFromTriplets(entries.begin(), entries.end());
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size, 3 * n);
+  for (int s = 0; s < count; ++s)
+    if (offset[static_cast<std::size_t>(s)] >= 0)
+      rhs.middleRows(offset[static_cast<std::size_t>(s)], store_[static_cast<std::size_t>(s)].rhs.rows()) =
+          store_[static_cast<std::size_t>(s)].rhs;
+  Eigen::MatrixXd solution;
+  if (sensitivitySettings_.backend == KktBackend::SparseUmfpack) {
+    Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu(blocks);
+    if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (UMFPACK) failed");
+    solution = lu.solve(rhs);
+  } else {
+    Eigen::KLU<Eigen::SparseMatrix<double>> lu(blocks);
+    if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (KLU) failed");
+    solution = lu.solve(rhs);
+  }
+  const int nc = static_cast<int>(contacts_.size());
+  for (int s = 0; s < count; ++s)
+    if (offset[static_cast<std::size_t>(s)] >= 0)
+      store_[static_cast<std::size_t>(s)].dF = solution.middleRows(offset[static_cast<std::size_t>(s)], 6 * nc);
+}
+
+void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double duration, MultiContactResult& r,
+                                                 MultiContactGradient& grad) {
+  const int n = model_.jointCount();
+  const int count = samples_.sampleCount(), m = samples_.parametrization().parametersPerJoint();
+  TrajectoryResult& motion = r.motion;
+  const SampleStore& store = store_[static_cast<std::size_t>(s)];
+  const Eigen::MatrixXd& J1 = store.wrenchToTorque;
   // dΓ/dx = dΓ0/dx − (∂J1/∂x) F − J1 dF/dx  (4.8)
-  w.dGammaDq = d.dtauDq - w.dJ1Fdq;
-  w.dGammaDq.noalias() -= J1 * w.dF.leftCols(n);
-  w.dGammaDv = d.dtauDv;
-  w.dGammaDv.noalias() -= J1 * w.dF.middleCols(n, n);
-  w.dGammaDa = d.dtauDa;
-  w.dGammaDa.noalias() -= J1 * w.dF.rightCols(n);
+  w.dGammaDq = store.fixedWrenchQ;
+  w.dGammaDq.noalias() -= J1 * store.dF.leftCols(n);
+  w.dGammaDv = store.fixedWrenchV;
+  w.dGammaDv.noalias() -= J1 * store.dF.middleCols(n, n);
+  w.dGammaDa = store.fixedWrenchA;
+  w.dGammaDa.noalias() -= J1 * store.dF.rightCols(n);
 
   SampleTorqueJacobian& torqueBlock = grad.torqueAndEnergy.torque[static_cast<std::size_t>(s)];
   samples_.chainRule(s, duration, w.dGammaDq, w.dGammaDv, w.dGammaDa, torqueBlock.dtauDx, torqueBlock.parameters);
   SampledTrajectory::durationDerivative(duration, w.dGammaDv, w.dGammaDa, motion.v.col(s), motion.a.col(s),
                                         torqueBlock.dtauDT);
   SampleWrenchJacobian& wrenchBlock = grad.wrenches[static_cast<std::size_t>(s)];
-  samples_.chainRule(s, duration, w.dF.leftCols(n), w.dF.middleCols(n, n), w.dF.rightCols(n), wrenchBlock.dFdx,
-                     wrenchBlock.parameters);
-  SampledTrajectory::durationDerivative(duration, w.dF.middleCols(n, n), w.dF.rightCols(n), motion.v.col(s),
+  samples_.chainRule(s, duration, store.dF.leftCols(n), store.dF.middleCols(n, n), store.dF.rightCols(n),
+                     wrenchBlock.dFdx, wrenchBlock.parameters);
+  SampledTrajectory::durationDerivative(duration, store.dF.middleCols(n, n), store.dF.rightCols(n), motion.v.col(s),
                                         motion.a.col(s), wrenchBlock.dFdT);
 
   // Energy (as TrajectoryGradientEvaluator, with Γ and dΓ/dx of the chosen wrenches).
@@ -206,8 +277,16 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
         current.inequalityMultipliers = before.inequalityMultipliers;
         current.coneMultipliers = before.coneMultipliers;
       }
-      evaluateSample(w, s, duration, r, grad);
+      prepareSample(w, s, duration, r, grad);
     }
+  }
+  if (sensitivitySettings_.layout == KktLayout::AllSamples) solveAllSamples();
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num(), used = omp_get_num_threads();
+    const int first = count * t / used, last = count * (t + 1) / used;
+    Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
+    for (int s = first; s < last; ++s) finishSample(w, s, duration, r, grad);
   }
   r.innerTimeUs = 0.0;
   r.infeasibleSamples = r.failedSamples = 0;

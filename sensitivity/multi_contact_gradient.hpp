@@ -51,7 +51,20 @@ class MultiContactGradientEvaluator {
 
  private:
   struct Workspace;
-  void evaluateSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
+  /// Per sample, kept between the passes: what dΓ/dx needs besides dF/dx, and the KKT system.
+  struct SampleStore {
+    Eigen::MatrixXd wrenchToTorque;              ///< J1
+    Eigen::MatrixXd fixedWrenchQ, fixedWrenchV, fixedWrenchA;  ///< ∂Γ/∂x at fixed F
+    Eigen::MatrixXd dF;                          ///< 6nc × 3n
+    Eigen::MatrixXd rhs;                         ///< all-samples layout: this sample's right-hand side
+    bool hasDerivative = false;
+  };
+  /// Pass 1: dynamics, inner solve, KKT factorisation (per-sample layout: also dF).
+  void prepareSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
+  /// Pass 3: dΓ/dx, the chain rule through the splines, the energy.
+  void finishSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
+  /// Pass 2 of the all-samples layout: one block-diagonal sparse factorisation and solve.
+  void solveAllSamples();
 
   const DynamicsModel& model_;
   ActuatorSet actuators_;
@@ -62,6 +75,8 @@ class MultiContactGradientEvaluator {
   Eigen::MatrixXd controlPoints_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
   std::vector<InnerResult> previous_;
+  std::vector<SampleStore> store_;
+  std::vector<Eigen::MatrixXd> sampleKkt_;  ///< all-samples layout: each sample's KKT matrix
 };
 
 }  // namespace mcopt

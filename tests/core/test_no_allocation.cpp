@@ -12,6 +12,7 @@
 #include "core/kinematics.hpp"
 #include "core/robot_files.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
+#include "sensitivity/multi_contact_gradient.hpp"
 
 namespace {
 std::atomic<long> allocations{0};
@@ -84,4 +85,25 @@ TEST_CASE("a multi-contact motion (inverse dynamics → inner active-set solve p
   const long during = allocations.load() - before;
   CHECK(during == 0);
   CHECK(result.failedSamples == 0);
+}
+
+TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) allocates nothing once warm",
+          "[sensitivity][allocation]") {
+  const RobotModel robot = loadUrdfFile(test::hrp2().urdf);
+  const DynamicsModel model(robot, "l_sole");
+  const auto surfaces = loadContactSurfaces(test::sourceDir() / "robots/hrp2/contacts.yaml", robot);
+  const Eigen::VectorXd halfSitting = loadPostures(test::sourceDir() / "robots/hrp2/postures.yaml", robot).at("half_sitting");
+  const MotionParametrization parametrization(robot.jointCount());
+  MultiContactGradientEvaluator evaluator(model, loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot),
+                                          SampledTrajectory(parametrization, 100), {surfaces[0], surfaces[1], surfaces[2]});
+  Eigen::VectorXd x = parametrization.constantMotion(halfSitting);
+  MultiContactResult result;
+  MultiContactGradient gradient;
+  evaluator.evaluate(x, 1.5, result, gradient);  // set-up
+  std::mt19937 rng(5);
+  x += test::randomVector(rng, x.size(), 0.01);
+  const long before = allocations.load();
+  evaluator.evaluate(x, 1.5, result, gradient);
+  CHECK(allocations.load() - before == 0);
+  CHECK(gradient.samplesWithoutDerivative == 0);
 }

@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "common/robots.hpp"
+#include "core/errors.hpp"
 #include "sensitivity/multi_contact_gradient.hpp"
 
 using namespace mcopt;
@@ -189,3 +190,38 @@ TEST_CASE("multi-contact gradients on the ../shared robots match central differe
   }
 }
 #endif
+
+TEST_CASE("the all-samples block-diagonal factorisation gives the per-sample gradients", "[sensitivity][gradient]") {
+  const Setup hrp2;
+  const DynamicsModel model(hrp2.robot, "l_sole");
+  const MotionParametrization parametrization(hrp2.robot.jointCount());
+  std::mt19937 rng(419);
+  const Eigen::VectorXd x = parametrization.constantMotion(hrp2.halfSitting) +
+                            0.01 * test::randomVector(rng, parametrization.parameterCount(), 1.0);
+  MultiContactResult result;
+  MultiContactGradient reference;
+  MultiContactGradientEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, 20), hrp2.contacts(3))
+      .evaluate(x, 1.4, result, reference);
+  REQUIRE(result.failedSamples == 0);
+  for (KktBackend backend : {KktBackend::SparseKlu, KktBackend::SparseUmfpack}) {
+    SensitivitySettings settings;
+    settings.backend = backend;
+    settings.layout = KktLayout::AllSamples;
+    MultiContactGradient gradient;
+    MultiContactGradientEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, 20), hrp2.contacts(3), {},
+                                  settings)
+        .evaluate(x, 1.4, result, gradient);
+    INFO(toString(backend));
+    const Eigen::VectorXd& e0 = reference.torqueAndEnergy.energyGradient;
+    CHECK((gradient.torqueAndEnergy.energyGradient - e0).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + e0.cwiseAbs().maxCoeff()));
+    for (std::size_t s = 0; s < 20; ++s) {
+      const Eigen::MatrixXd& a = reference.wrenches[s].dFdx;
+      CHECK((gradient.wrenches[s].dFdx - a).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + a.cwiseAbs().maxCoeff()));
+    }
+  }
+  SensitivitySettings dense;
+  dense.layout = KktLayout::AllSamples;
+  CHECK_THROWS_AS(MultiContactGradientEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, 20),
+                                                hrp2.contacts(3), {}, dense),
+                  InputError);
+}
