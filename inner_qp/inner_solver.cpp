@@ -261,10 +261,16 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     if (slack.cwiseAbs().maxCoeff() <= settings.tolerance * scale) slack.setZero();
     if (!phase1.converged) outcome.converged = false;
     // A certificate accurate to kktTolerance (relative) cannot tell a slack below
-    // √kktTolerance of the data's scale from a solve that failed: not called infeasible.
+    // √kktTolerance of the data's scale from zero: the sample is treated as feasible and
+    // solved again, from the elastic point, as the original problem; its own KKT check
+    // then decides (it is never called infeasible on such a slack).
     if (slack.cwiseAbs().maxCoeff() <= std::sqrt(settings.kktTolerance) * scale) {
-      diagnostics += "least slack too small to tell from a failed solve; ";
-      outcome.converged = false;
+      diagnostics += "least slack negligible, solved again from the elastic point; ";
+      const int before = outcome.iterations;
+      outcome = run(p, BalanceMode::Equality, 0.0, settings, x);
+      outcome.iterations += before;
+      solved = &p;
+      slack.setZero();
     }
   }
   finishResult(*solved, x.data(), r);

@@ -5,6 +5,7 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <Eigen/UmfPackSupport>
+#include <cmath>
 #include <sstream>
 #include <vector>
 
@@ -42,16 +43,24 @@ struct InnerSensitivity::Impl {
   SensitivityDiagnostics diagnostics;
   int variables = 0;
   Eigen::MatrixXd kkt;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu;
   Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> rankRevealing;
   bool useRankRevealing = false;
   Eigen::SparseMatrix<double> sparse;
   Eigen::KLU<Eigen::SparseMatrix<double>> klu;
   Eigen::UmfPackLU<Eigen::SparseMatrix<double>> umfpack;
-  KktBackend used = KktBackend::Dense;
+  KktBackend backendInUse = KktBackend::Dense;
   Eigen::MatrixXd weightedWrenchToTorque;  ///< diag(w) J1 of the factorised problem, for dataSensitivities
   Eigen::MatrixXd lagrangianHessian, rhs, solution;
   std::vector<char> active;
+  // One matrix and LU per possible system size (n + 6 … n + 6 + rows + cones), all made when a
+  // problem shape is first seen: factorising exactly the used block costs what a variable
+  // size would, and allocates nothing afterwards.
+  int smallest = 0, capacity = -1;
+  std::vector<Eigen::MatrixXd> systemBySize;
+  std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> luBySize;
+  int used = 0;  ///< size of the system in use
+  const Eigen::MatrixXd& system() const { return systemBySize[static_cast<std::size_t>(used - smallest)]; }
+  const Eigen::PartialPivLU<Eigen::MatrixXd>& factor() const { return luBySize[static_cast<std::size_t>(used - smallest)]; }
 };
 
 InnerSensitivity::InnerSensitivity(SensitivitySettings settings) : impl_(std::make_unique<Impl>()) {
@@ -86,10 +95,9 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   m.active.assign(static_cast<std::size_t>(rowCount + coneCount), 0);
   for (int a : r.activeSet) m.active[static_cast<std::size_t>(a)] = 1;
 
-  // Fixed size per problem shape, so that repeated factorisations reuse every buffer: one
-  // slot per linear row and cone; the slots not used (inactive constraints) are decoupled
-  // identity rows, dμ = 0, which changes nothing. An unloaded contact's pins (≤ 6) take the
-  // slots of its own rows and cone (≥ 6 in every contact model).
+  // Assembled in a buffer of the largest size (one slot per linear row and cone; an unloaded
+  // contact's pins, ≤ 6, take the slots of its own rows and cone, ≥ 6 in every contact model),
+  // the used rows first; the used block is then factorised.
   const int size = n + 6 + rowCount + coneCount;
   m.kkt.setZero(size, size);
   m.lagrangianHessian = p.hessian;
@@ -113,7 +121,12 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     // Held at zero by its fz_min row or by its cone's apex (the active-set method certifies
     // an unloaded contact through the cone's planes, whose multipliers make y_z).
     const bool apex = cone >= 0 && m.active[static_cast<std::size_t>(rowCount + cone)];
-    if ((m.active[static_cast<std::size_t>(fzRow)] || apex) && std::abs(fz) <= m.settings.unloadedForce * forceScale) {
+    // An interior-point result stops near the apex, not on it: a contact whose normal and
+    // shear forces are both negligible is unloaded too (never a curvature ν / ‖f_t‖ there).
+    const double shearNorm = F.segment<2>(6 * i).norm();
+    const bool nearApex = std::abs(fz) <= m.settings.unloadedForce * forceScale &&
+                          shearNorm <= m.settings.unloadedForce * forceScale;
+    if ((m.active[static_cast<std::size_t>(fzRow)] || apex) && nearApex) {
       // Unloaded: held at zero wrench while its pushing multiplier is positive.
       ++m.diagnostics.unloadedContacts;
       double push = r.inequalityMultipliers[fzRow];
@@ -138,7 +151,7 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       const double nu = r.coneMultipliers[3 * cone + 2] / c.friction;
       const Eigen::Vector2d shear = F.segment<2>(c.index);
       const double norm = shear.norm();
-      if (nu > strict && norm > 0.0) {
+      if (nu > strict && norm > m.settings.unloadedForce * forceScale) {
         const Eigen::Vector2d u = shear / norm;
         m.kkt(next, c.index) = m.kkt(c.index, next) = u.x();
         m.kkt(next, c.index + 1) = m.kkt(c.index + 1, next) = u.y();
@@ -152,30 +165,43 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     }
   }
   m.kkt.topLeftCorner(n, n) = m.lagrangianHessian;
-  for (int slot = next; slot < size; ++slot) m.kkt(slot, slot) = 1.0;  // unused slots: dμ = 0
-  m.diagnostics.size = size;
+  if (m.capacity != size || m.smallest != n + 6) {
+    m.smallest = n + 6, m.capacity = size;
+    m.systemBySize.clear();
+    m.luBySize.clear();
+    for (int k = m.smallest; k <= size; ++k) {
+      m.systemBySize.emplace_back(k, k);
+      m.luBySize.emplace_back(k);
+    }
+  }
+  m.used = next;
+  m.diagnostics.size = next;
+  Eigen::MatrixXd& system = m.systemBySize[static_cast<std::size_t>(next - m.smallest)];
+  system = m.kkt.topLeftCorner(next, next);
 
   // Dense LU always gives the condition estimate; a near-singular system (dependent active
   // rows, whose multipliers are then not unique while dF is) is solved in the least-norm sense.
-  m.lu.compute(m.kkt);
-  m.diagnostics.reciprocalCondition = m.lu.rcond();
+  Eigen::PartialPivLU<Eigen::MatrixXd>& lu = m.luBySize[static_cast<std::size_t>(next - m.smallest)];
+  lu.compute(system);
+  m.diagnostics.reciprocalCondition = lu.rcond();
+  if (!std::isfinite(m.diagnostics.reciprocalCondition)) m.diagnostics.reciprocalCondition = 0.0;
   m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
-  if (m.useRankRevealing) m.rankRevealing.compute(m.kkt);
-  m.used = KktBackend::Dense;
+  if (m.useRankRevealing) m.rankRevealing.compute(system);
+  m.backendInUse = KktBackend::Dense;
   if (m.settings.backend != KktBackend::Dense && !m.useRankRevealing) {
-    m.sparse = m.kkt.sparseView();
+    m.sparse = system.sparseView();
     if (m.settings.backend == KktBackend::SparseKlu) {
       m.klu.compute(m.sparse);
-      if (m.klu.info() == Eigen::Success) m.used = KktBackend::SparseKlu;
+      if (m.klu.info() == Eigen::Success) m.backendInUse = KktBackend::SparseKlu;
     } else {
       m.umfpack.compute(m.sparse);
-      if (m.umfpack.info() == Eigen::Success) m.used = KktBackend::SparseUmfpack;
+      if (m.umfpack.info() == Eigen::Success) m.backendInUse = KktBackend::SparseUmfpack;
     }
   }
   return m.diagnostics;
 }
 
-const Eigen::MatrixXd& InnerSensitivity::kktMatrix() const { return impl_->kkt; }
+const Eigen::MatrixXd& InnerSensitivity::kktMatrix() const { return impl_->system(); }
 
 void InnerSensitivity::rightHandSide(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity,
                                      const Eigen::Ref<const Eigen::MatrixXd>& dBalance, Eigen::MatrixXd& rhs) const {
@@ -202,14 +228,14 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
   rhs.topRows(n) = -dStationarity;
   rhs.middleRows(n, 6) = -dBalance;
   solution.resize(size, dStationarity.cols());
-  switch (m.used) {
+  switch (m.backendInUse) {
     case KktBackend::SparseKlu: solution = m.klu.solve(rhs); break;
     case KktBackend::SparseUmfpack: solution = m.umfpack.solve(rhs); break;
     case KktBackend::Dense:
       if (m.useRankRevealing)
         solution = m.rankRevealing.solve(rhs);
       else
-        solution.noalias() = m.lu.solve(rhs);
+        solution.noalias() = m.factor().solve(rhs);
       break;
   }
   dWrenches = solution.topRows(n);

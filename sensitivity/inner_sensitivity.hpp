@@ -46,8 +46,10 @@ struct SensitivitySettings {
   /// A constraint whose multiplier is at most this fraction of the data's scale is weakly
   /// active: left out of the system and counted as degenerate.
   double strictMultiplier = 1e-9;
-  /// A contact with fz below this fraction of the force scale and its fz_min row active is unloaded.
-  double unloadedForce = 1e-9;
+  /// A contact whose fz and shear are both below this fraction of the force scale, with its
+  /// fz_min row or its cone's apex active, is unloaded (an interior-point result stops near
+  /// the apex, the active-set method on it).
+  double unloadedForce = 1e-6;
 };
 
 struct SensitivityDiagnostics {

