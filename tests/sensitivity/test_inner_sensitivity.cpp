@@ -242,3 +242,38 @@ TEST_CASE("sensitivities from each solver's own result agree with the active-set
   CHECK(compared[0] >= 8);
   CHECK(compared[1] >= 8);
 }
+
+TEST_CASE("a weakly active constraint is reported as degenerate and left out", "[sensitivity]") {
+  // An active constraint whose multiplier is zero has one-sided derivatives only: the
+  // diagnostics must say so. Made here by zeroing the multiplier of one active row of a
+  // certified solution (what a constraint touching the optimum by accident looks like).
+  std::mt19937 rng(337);
+  auto activeSet = makeActiveSetSolver();
+  int tested = 0;
+  for (int trial = 0; trial < 20 && tested < 3; ++trial) {
+    const test::RandomProblem r = test::randomProblem(rng, 3, 30);
+    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    InnerResult solution;
+    activeSet->solve(p, solution);
+    REQUIRE(solution.status == InnerStatus::Optimal);
+    int row = -1;
+    const auto perContact = static_cast<int>(p.inequality.rows()) / p.contactCount;
+    for (int a : solution.activeSet)
+      if (a < p.inequality.rows() && solution.inequalityMultipliers[a] > 0.0 &&
+          solution.wrenches[6 * (a / perContact) + 2] > 1.0)  // a loaded contact's row (an unloaded one is pinned)
+        row = a;
+    if (row < 0) continue;
+    ++tested;
+    InnerSensitivity strictly;
+    const SensitivityDiagnostics before = strictly.factorize(p, solution);
+    CHECK_FALSE(before.degenerate());
+    solution.inequalityMultipliers[row] = 0.0;
+    InnerSensitivity weakly;
+    const SensitivityDiagnostics& after = weakly.factorize(p, solution);
+    CHECK(after.weaklyActive == before.weaklyActive + 1);
+    CHECK(after.activeRows == before.activeRows - 1);
+    CHECK(after.degenerate());
+    CHECK_THAT(after.describe(), Catch::Matchers::Contains("weakly active"));
+  }
+  CHECK(tested >= 2);
+}

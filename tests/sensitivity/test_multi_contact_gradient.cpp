@@ -37,7 +37,7 @@ TEST_CASE("multi-contact torque, wrench and energy gradients match central diffe
   const MotionParametrization parametrization(hrp2.robot.jointCount());
   const int samples = 12;
   std::mt19937 rng(401);
-  for (int contactCount : {2, 3}) {
+  for (int contactCount : {2, 3, 4}) {
     for (KktBackend backend : {KktBackend::Dense, KktBackend::SparseKlu}) {
       SensitivitySettings sensitivity;
       sensitivity.backend = backend;
