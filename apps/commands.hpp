@@ -13,5 +13,6 @@ Runner addRobotInfo(CLI::App& robot);
 Runner addDynamics(CLI::App& app);
 Runner addEvaluate(CLI::App& app);
 Runner addInner(CLI::App& app);
+Runner addRun(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(dynamics, mcopt::cli::addDynamics(*dynamics));
   CLI::App* evaluate = app.add_subcommand("evaluate", "torques, reference wrench and energy of a spline motion");
   runners.emplace_back(evaluate, mcopt::cli::addEvaluate(*evaluate));
+  CLI::App* runCommand = app.add_subcommand("run", "optimise a motion from a scenario file with Ipopt");
+  runners.emplace_back(runCommand, mcopt::cli::addRun(*runCommand));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {

@@ -121,11 +121,24 @@ void MotionParametrization::velocityControlPoints(const Eigen::MatrixXd& points,
     velocity.col(k) = 3.0 * (points.col(k + 1) - points.col(k)) / (duration * (u[k + 4] - u[k + 1]));
 }
 
-SampledTrajectory::SampledTrajectory(const MotionParametrization& parametrization, int sampleCount)
-    : parametrization_(parametrization) {
+namespace {
+std::vector<double> uniformTimes(int sampleCount) {
   if (sampleCount < 2) throw InputError("a trajectory needs at least 2 samples, got " + std::to_string(sampleCount));
-  for (int s = 0; s < sampleCount; ++s) {
-    const double u = static_cast<double>(s) / (sampleCount - 1);
+  std::vector<double> u;
+  for (int s = 0; s < sampleCount; ++s) u.push_back(static_cast<double>(s) / (sampleCount - 1));
+  return u;
+}
+}  // namespace
+
+SampledTrajectory::SampledTrajectory(const MotionParametrization& parametrization, int sampleCount)
+    : SampledTrajectory(parametrization, uniformTimes(sampleCount)) {}
+
+SampledTrajectory::SampledTrajectory(const MotionParametrization& parametrization,
+                                     const std::vector<double>& normalisedTimes)
+    : parametrization_(parametrization) {
+  for (const double u : normalisedTimes) {
+    if (!(u >= 0.0 && u <= 1.0))
+      throw InputError("normalised sample time must lie in [0, 1], got " + std::to_string(u));
     u_.push_back(u);
     const LocalBasis local = parametrization.basis().evaluate(u);
     bases_.push_back(local);

@@ -79,6 +79,8 @@ struct LocalParameterWeights {
 class SampledTrajectory {
  public:
   SampledTrajectory(const MotionParametrization& parametrization, int sampleCount);
+  /// Samples at given normalised times u = t / T ∈ [0, 1] (task instants, fine resampling).
+  SampledTrajectory(const MotionParametrization& parametrization, const std::vector<double>& normalisedTimes);
   int sampleCount() const { return static_cast<int>(bases_.size()); }
   const MotionParametrization& parametrization() const { return parametrization_; }
   double time(int sample, double duration) const { return duration * u_[sample]; }

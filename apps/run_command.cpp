@@ -1,0 +1,153 @@
+// `mcopt run`: the project's main job (issue 7). Reads a scenario (docs/scenarios.md),
+// optionally optimises the static start and end postures (report §3.5), then optimises the
+// whole motion with Ipopt (formulation.md §10), printing a line per iteration, and writes
+// the results atomically. Ctrl-C (SIGINT) or SIGTERM stops Ipopt at the end of the current
+// iteration; the last iterate is then written with status "interrupted".
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <iomanip>
+#include <iostream>
+
+#include "apps/commands.hpp"
+#include "apps/run_output.hpp"
+#include "outer_nlp/configuration_problem.hpp"
+#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/scenario.hpp"
+
+namespace mcopt::cli {
+
+namespace {
+
+volatile std::sig_atomic_t stopRequested = 0;
+extern "C" void requestStop(int) { stopRequested = 1; }
+
+struct RunOptions {
+  std::string scenario, out = "mcopt-run";
+  std::string configurationOptimisation;  ///< "", "on" or "off": overrides the scenario
+  int maxIterations = -1;
+};
+
+constexpr int kExitNotOptimal = 4;
+constexpr int kExitInterrupted = 130;
+
+double seconds(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// Configuration optimisation of one end of the motion; returns the posture to start from.
+Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& motion, const Eigen::VectorXd& guess,
+                                double instant, const char* which, PostureOutcome& outcome) {
+  ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant);
+  outcome.optimised = true;
+  outcome.staticPowerBefore = problem.staticPower(guess);
+  IpoptSettings settings;
+  SolverOption iterations;
+  iterations.name = "max_iter", iterations.type = SolverOption::Type::Integer;
+  iterations.integer = scenario.configurationIterations, iterations.origin = "initialisation.configuration_iterations: ";
+  settings.options = {iterations};
+  const IpoptOutcome result =
+      solveWithIpopt(problem, guess, settings, [](const IterationReport&) { return stopRequested == 0; });
+  outcome.status = result.status;
+  outcome.iterations = result.iterations;
+  outcome.seconds = result.seconds;
+  const bool usable = result.x.size() == guess.size() && result.x.allFinite();
+  outcome.staticPowerAfter = usable ? problem.staticPower(result.x) : outcome.staticPowerBefore;
+  std::cout << "  " << which << " posture: " << result.status << " after " << result.iterations
+            << " iterations, static power " << std::setprecision(4) << outcome.staticPowerBefore << " → "
+            << outcome.staticPowerAfter << " W (" << std::setprecision(3) << result.seconds << " s)\n";
+  return usable ? result.x : guess;
+}
+
+int runMotion(const RunOptions& o) {
+  const auto clock = std::chrono::steady_clock::now();
+  Scenario scenario = loadScenario(o.scenario);
+  if (o.configurationOptimisation == "on") scenario.configurationOptimisation = true;
+  if (o.configurationOptimisation == "off") scenario.configurationOptimisation = false;
+  if (o.maxIterations >= 0) {
+    SolverOption limit;
+    limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
+    limit.origin = "--max-iterations: ";
+    scenario.solverOptions.push_back(limit);
+  }
+  for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
+  MotionProblem problem(scenario);
+  std::cout << "mcopt run " << o.scenario << "\n";
+  if (!scenario.description.empty()) std::cout << "  " << scenario.description << "\n";
+  std::cout << "  robot " << scenario.robot.name << ": " << scenario.robot.jointCount() << " joints, "
+            << std::setprecision(4) << scenario.robot.totalMass() << " kg; reference body " << scenario.referenceBody
+            << ", contact " << scenario.support.name << "\n"
+            << "  " << problem.variableCount() << " variables, " << problem.constraintCount() << " constraints, "
+            << problem.jacobianNonZeros() << " Jacobian non-zeros; " << scenario.samples << " samples over "
+            << scenario.duration.initial << " s" << (problem.durationIsFree() ? " (duration free)" : "") << "\n";
+
+  stopRequested = 0;
+  std::signal(SIGINT, requestStop);
+  std::signal(SIGTERM, requestStop);
+
+  RunRecord record;
+  Eigen::VectorXd start = scenario.start, end = scenario.end;
+  const auto configurationClock = std::chrono::steady_clock::now();
+  if (scenario.configurationOptimisation) {
+    std::cout << "configuration optimisation (report §3.5)\n";
+    if (!scenario.fixStart) start = optimisePosture(scenario, problem, start, 0.0, "start", record.start);
+    if (!scenario.fixEnd) end = optimisePosture(scenario, problem, end, scenario.duration.initial, "end", record.end);
+  }
+  record.configurationSeconds = seconds(configurationClock);
+
+  const Eigen::VectorXd x0 = problem.initialPoint(start, end);
+  std::cout << "motion optimisation (Ipopt, limited-memory Hessian)\n"
+            << "   iter      energy [J]   violation   dual inf.     elapsed\n";
+  IpoptSettings settings;
+  settings.options = scenario.solverOptions;
+  const auto optimisationClock = std::chrono::steady_clock::now();
+  record.solver = solveWithIpopt(problem, x0, settings, [](const IterationReport& r) {
+    std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s\n", r.iteration, r.objective, r.violation, r.dualInfeasibility,
+                r.elapsedSeconds);
+    std::fflush(stdout);
+    return stopRequested == 0;
+  });
+  record.optimisationSeconds = seconds(optimisationClock);
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+
+  record.status = record.solver.status;
+  record.message = record.solver.message;
+  record.x = record.solver.x.size() == x0.size() && record.solver.x.allFinite() ? record.solver.x : x0;
+  if (record.solver.x.size() != x0.size()) record.reason = "Ipopt returned no iterate; the initial motion is written";
+  if (!record.solver.evaluationError.empty()) record.reason = "evaluation failed: " + record.solver.evaluationError;
+  if (record.status == "interrupted") record.reason = "interrupted by a signal; the last iterate is written";
+  else if (!record.solver.optimal && record.reason.empty()) record.reason = "Ipopt: " + record.solver.message;
+  record.totalSeconds = seconds(clock);
+  const auto [energy, violation] = writeRunOutput(o.out, problem, record);
+
+  std::cout << "\nEXIT: " << record.message << "\n"
+            << "  status             " << record.status << "\n"
+            << std::setprecision(6) << "  energy             " << energy << " J  (∫ Σ max(P, 0) dt at the samples)\n"
+            << "  max violation      " << std::setprecision(3) << violation << "\n"
+            << "  iterations         " << record.solver.iterations << "\n"
+            << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
+            << " s, motion " << record.optimisationSeconds << " s)\n"
+            << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json\n";
+  if (!record.reason.empty() && !record.solver.optimal) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
+  if (record.status == "interrupted") return kExitInterrupted;
+  return record.solver.optimal ? 0 : kExitNotOptimal;
+}
+
+}  // namespace
+
+Runner addRun(CLI::App& command) {
+  auto o = std::make_shared<RunOptions>();
+  command.add_option("scenario", o->scenario, "scenario YAML file (docs/scenarios.md)")->required()->check(CLI::ExistingFile);
+  command.add_option("--out", o->out, "folder for result.json, trajectory.csv, power_fine.csv, states.json")
+      ->capture_default_str();
+  command.add_option("--configuration-optimisation", o->configurationOptimisation,
+                     "on or off: override the scenario's initialisation.configuration_optimisation")
+      ->check(CLI::IsMember({"on", "off"}));
+  command.add_option("--max-iterations", o->maxIterations, "override Ipopt's max_iter for the motion");
+  return [o] { return runMotion(*o); };
+}
+
+}  // namespace mcopt::cli

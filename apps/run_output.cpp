@@ -1,0 +1,159 @@
+#include "apps/run_output.hpp"
+
+#include <iomanip>
+#include <sstream>
+
+#include "apps/json_io.hpp"
+#include "core/atomic_file.hpp"
+#include "core/trajectory_evaluation.hpp"
+
+namespace mcopt::cli {
+
+namespace {
+
+using json_io::Json;
+using json_io::matrixToJson;
+using json_io::toJson;
+
+Json posture(const PostureOutcome& p) {
+  Json j;
+  j["optimised"] = p.optimised;
+  if (!p.optimised) return j;
+  j["status"] = p.status;
+  j["static_power_before_W"] = p.staticPowerBefore;
+  j["static_power_after_W"] = p.staticPowerAfter;
+  j["iterations"] = p.iterations;
+  j["seconds"] = p.seconds;
+  return j;
+}
+
+/// A JSON number, or null for NaN (a centre of pressure without a load).
+Json numberOrNull(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+}  // namespace
+
+std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
+                                         const RunRecord& record) {
+  const Scenario& scenario = problem.scenario();
+  const RobotModel& robot = scenario.robot;
+  const Eigen::VectorXd parameters = problem.motionParameters(record.x);
+  const double T = problem.duration(record.x);
+  const int n = robot.jointCount();
+
+  TrajectoryEvaluator regular(problem.model(), scenario.actuators, problem.samples());
+  TrajectoryResult r;
+  regular.evaluate(parameters, T, r);
+  TrajectoryEvaluator fine(problem.model(), scenario.actuators,
+                           SampledTrajectory(problem.parametrization(), scenario.outputSamples));
+  TrajectoryResult f;
+  fine.evaluate(parameters, T, f);
+  const MotionProblem::Violations violations = problem.violations(record.x);
+
+  const int N = static_cast<int>(r.time.size());
+  Eigen::MatrixXd contactWrench(N, 6), cop(N, 2);
+  for (int s = 0; s < N; ++s) {
+    const Vector6 w0 = r.referenceWrench.col(s);
+    // referenceWrench is at the reference frame's origin; the support rows take W0 about
+    // the world origin: move it back (m_O = m_ref + p_ref × f).
+    Vector6 atOrigin = w0;
+    atOrigin.tail<3>() += problem.model().referencePose().translation.cross(w0.head<3>());
+    contactWrench.row(s) = problem.support().contactWrench(atOrigin).transpose();
+    cop.row(s) = problem.support().centerOfPressure(atOrigin).transpose();
+  }
+
+  Json result;
+  result["status"] = record.status;
+  result["energy"] = r.energy;
+  result["max_violation"] = violations.overall;
+  result["message"] = record.message;
+  if (!record.reason.empty()) result["reason"] = record.reason;
+  result["scenario"] = scenario.file.string();
+  result["objective_value"] = record.solver.objective;
+  result["energy_form"] = scenario.energyForm == EnergyForm::Epigraph ? "epigraph" : "smooth_max";
+  result["energy_fine"] = f.energy;
+  result["joint_names"] = robot.jointNames();
+  result["reference_body"] = scenario.referenceBody;
+  result["duration"] = T;
+  Json params = Json::object();
+  const int m = problem.parametrization().parametersPerJoint();
+  for (int j = 0; j < n; ++j) params[robot.joints[static_cast<std::size_t>(j)].name] = toJson(parameters.segment(j * m, m));
+  result["parameters"] = params;
+  result["time"] = toJson(r.time);
+  result["q"] = matrixToJson(r.q.transpose());
+  result["v"] = matrixToJson(r.v.transpose());
+  result["a"] = matrixToJson(r.a.transpose());
+  result["torques"] = matrixToJson(r.tau.transpose());
+  result["reference_wrench"] = matrixToJson(r.referenceWrench.transpose());
+  result["contact_wrench"] = {{"contact", scenario.support.name}, {"frame", "contact"}, {"wrench", matrixToJson(contactWrench)}};
+  Json copJson = Json::array();
+  for (int s = 0; s < N; ++s) copJson.push_back({numberOrNull(cop(s, 0)), numberOrNull(cop(s, 1))});
+  result["center_of_pressure"] = copJson;
+  result["power"] = matrixToJson(r.power.transpose());
+  result["power_fine"] = {{"time", toJson(f.time)}, {"power", matrixToJson(f.power.transpose())}};
+  Json byKind = Json::object();
+  byKind["position_limit"] = violations.positionLimit;
+  for (int k = 0; k < kConstraintKindCount; ++k)
+    byKind[constraintKindName(static_cast<ConstraintKind>(k))] = violations.byKind[static_cast<std::size_t>(k)];
+  result["violation_by_kind"] = byKind;
+  if (violations.worstRow >= 0) result["worst_constraint"] = problem.rowName(violations.worstRow);
+  result["solver"] = {{"name", "ipopt"},
+                      {"status", record.solver.status},
+                      {"message", record.solver.message},
+                      {"iterations", record.solver.iterations},
+                      {"objective_evaluations", record.solver.objectiveEvaluations},
+                      {"gradient_evaluations", record.solver.gradientEvaluations},
+                      {"constraint_evaluations", record.solver.constraintEvaluations},
+                      {"jacobian_evaluations", record.solver.jacobianEvaluations},
+                      {"variables", problem.variableCount()},
+                      {"constraints", problem.constraintCount()},
+                      {"jacobian_nonzeros", problem.jacobianNonZeros()}};
+  if (!record.solver.evaluationError.empty()) result["solver"]["evaluation_error"] = record.solver.evaluationError;
+  result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
+  result["timings"] = {{"configuration_seconds", record.configurationSeconds},
+                       {"optimisation_seconds", record.optimisationSeconds},
+                       {"total_seconds", record.totalSeconds}};
+
+  // The states as a `mcopt dynamics` input: re-evaluating them reproduces `torques`.
+  Json states;
+  states["joint_names"] = robot.jointNames();
+  states["gravity"] = toJson(scenario.gravity);
+  const RigidTransform& pose = problem.model().referencePose();
+  states["reference_pose"] = {{"position", toJson(pose.translation)},
+                              {"quaternion_xyzw", toJson(quaternionXyzwFromRotation(pose.rotation))}};
+  states["states"] = Json::array();
+  for (int s = 0; s < N; ++s)
+    states["states"].push_back({{"q", toJson(r.q.col(s))}, {"v", toJson(r.v.col(s))}, {"a", toJson(r.a.col(s))}});
+
+  std::ostringstream csv;
+  csv << std::setprecision(12) << "time";
+  for (const char* kind : {"q", "v", "a", "tau", "power"})
+    for (const Joint& joint : robot.joints) csv << "," << kind << ":" << joint.name;
+  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) csv << ",contact_wrench:" << c;
+  csv << ",cop:x,cop:y\n";
+  for (int s = 0; s < N; ++s) {
+    csv << r.time[s];
+    for (const Eigen::MatrixXd* mat : {&r.q, &r.v, &r.a, &r.tau, &r.power})
+      for (int j = 0; j < n; ++j) csv << "," << (*mat)(j, s);
+    for (int c = 0; c < 6; ++c) csv << "," << contactWrench(s, c);
+    csv << "," << cop(s, 0) << "," << cop(s, 1) << "\n";
+  }
+  std::ostringstream fineCsv;
+  fineCsv << std::setprecision(12) << "time";
+  for (const Joint& joint : robot.joints) fineCsv << ",power:" << joint.name;
+  fineCsv << "\n";
+  for (Eigen::Index s = 0; s < f.time.size(); ++s) {
+    fineCsv << f.time[s];
+    for (int j = 0; j < n; ++j) fineCsv << "," << f.power(j, s);
+    fineCsv << "\n";
+  }
+
+  std::filesystem::create_directories(directory);
+  writeFileAtomically(directory / "trajectory.csv", csv.str());
+  writeFileAtomically(directory / "power_fine.csv", fineCsv.str());
+  writeFileAtomically(directory / "states.json", states.dump(1) + "\n");
+  // result.json last: once it names this run, the other files are this run's too.
+  writeFileAtomically(directory / "result.json", result.dump(1) + "\n");
+  return {r.energy, violations.overall};
+}
+
+}  // namespace mcopt::cli

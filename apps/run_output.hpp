@@ -1,0 +1,37 @@
+#pragma once
+// What `mcopt run` writes (docs/scenarios.md, "Results"): result.json, trajectory.csv,
+// power_fine.csv and states.json (the sampled states as a `mcopt dynamics` input), each
+// written atomically so that an interrupted run never leaves a half-written file.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <string>
+
+#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/motion_problem.hpp"
+
+namespace mcopt::cli {
+
+/// One static posture found by configuration optimisation (report §3.5).
+struct PostureOutcome {
+  bool optimised = false;
+  std::string status;
+  double staticPowerBefore = 0.0, staticPowerAfter = 0.0;  ///< [W]
+  int iterations = 0;
+  double seconds = 0.0;
+};
+
+struct RunRecord {
+  std::string status, message, reason;  ///< reason: why a run that is not optimal ended
+  Eigen::VectorXd x;                    ///< the outer problem's variables
+  PostureOutcome start, end;
+  IpoptOutcome solver;
+  double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
+};
+
+/// Evaluates the motion of `record.x` (regular and fine samples) and writes the files.
+/// Returns the exact energy ∫ Σ max(P, 0) dt and the largest violation (for the summary).
+std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
+                                         const RunRecord& record);
+
+}  // namespace mcopt::cli

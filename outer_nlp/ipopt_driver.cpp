@@ -1,0 +1,190 @@
+#include "outer_nlp/ipopt_driver.hpp"
+
+#include <IpIpoptApplication.hpp>
+#include <IpSolveStatistics.hpp>
+#include <IpTNLP.hpp>
+
+#include <chrono>
+
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+namespace {
+
+using Ipopt::Index;
+using Ipopt::Number;
+
+/// Ipopt's outcome in our words (result.json's `status`) and in its own.
+std::pair<std::string, std::string> describe(Ipopt::SolverReturn status) {
+  switch (status) {
+    case Ipopt::SUCCESS: return {"optimal", "Optimal Solution Found"};
+    case Ipopt::MAXITER_EXCEEDED: return {"maximum_iterations", "Maximum Number of Iterations Exceeded"};
+    case Ipopt::CPUTIME_EXCEEDED: return {"maximum_cpu_time", "Maximum CPU time exceeded"};
+    case Ipopt::STOP_AT_TINY_STEP: return {"tiny_step", "Search Direction is becoming Too Small"};
+    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return {"acceptable", "Solved To Acceptable Level"};
+    case Ipopt::LOCAL_INFEASIBILITY: return {"infeasible", "Converged to a point of local infeasibility"};
+    case Ipopt::USER_REQUESTED_STOP: return {"interrupted", "Stopping optimization at current point as requested by user"};
+    case Ipopt::FEASIBLE_POINT_FOUND: return {"feasible_point_found", "Feasible point for square problem found"};
+    case Ipopt::DIVERGING_ITERATES: return {"diverging", "Iterates diverging; problem might be unbounded"};
+    case Ipopt::RESTORATION_FAILURE: return {"restoration_failed", "Restoration Phase Failed"};
+    case Ipopt::ERROR_IN_STEP_COMPUTATION: return {"error_in_step_computation", "Error in step computation"};
+    case Ipopt::INVALID_NUMBER_DETECTED: return {"invalid_number", "Invalid number in NLP function or derivative detected"};
+    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return {"too_few_degrees_of_freedom", "Problem has too few degrees of freedom"};
+    case Ipopt::INVALID_OPTION: return {"invalid_option", "Invalid option"};
+    case Ipopt::OUT_OF_MEMORY: return {"out_of_memory", "Not enough memory"};
+    default: return {"internal_error", "Internal error"};
+  }
+}
+
+class ProblemTnlp final : public Ipopt::TNLP {
+ public:
+  ProblemTnlp(NlpProblem& problem, const Eigen::VectorXd& start, IpoptOutcome& outcome,
+              const std::function<bool(const IterationReport&)>& onIteration)
+      : problem_(problem), start_(start), outcome_(outcome), onIteration_(onIteration),
+        clock_(std::chrono::steady_clock::now()) {
+    problem_.variableBounds(xLower_, xUpper_);
+    problem_.constraintBounds(gLower_, gUpper_);
+  }
+
+  bool get_nlp_info(Index& n, Index& m, Index& nnzJacobian, Index& nnzHessian, IndexStyleEnum& style) override {
+    n = problem_.variableCount();
+    m = problem_.constraintCount();
+    nnzJacobian = static_cast<Index>(problem_.jacobianRows().size());
+    nnzHessian = 0;  // limited-memory Hessian
+    style = C_STYLE;
+    return true;
+  }
+  bool get_bounds_info(Index n, Number* xL, Number* xU, Index m, Number* gL, Number* gU) override {
+    auto finite = [](double v) { return std::isfinite(v) ? v : (v > 0 ? 2e19 : -2e19); };
+    for (Index i = 0; i < n; ++i) xL[i] = finite(xLower_[i]), xU[i] = finite(xUpper_[i]);
+    for (Index i = 0; i < m; ++i) gL[i] = finite(gLower_[i]), gU[i] = finite(gUpper_[i]);
+    return true;
+  }
+  bool get_starting_point(Index n, bool initX, Number* x, bool initZ, Number*, Number*, Index, bool initLambda,
+                          Number*) override {
+    if (!initX || initZ || initLambda) return false;
+    Eigen::Map<Eigen::VectorXd>(x, n) = start_;
+    return true;
+  }
+  bool eval_f(Index n, const Number* x, bool, Number& value) override {
+    return guarded([&] {
+      ++outcome_.objectiveEvaluations;
+      value = problem_.objective(copy(x, n));
+    });
+  }
+  bool eval_grad_f(Index n, const Number* x, bool, Number* gradient) override {
+    return guarded([&] {
+      ++outcome_.gradientEvaluations;
+      problem_.objectiveGradient(copy(x, n), buffer_);
+      Eigen::Map<Eigen::VectorXd>(gradient, n) = buffer_;
+    });
+  }
+  bool eval_g(Index n, const Number* x, bool, Index m, Number* g) override {
+    return guarded([&] {
+      ++outcome_.constraintEvaluations;
+      problem_.constraints(copy(x, n), buffer_);
+      Eigen::Map<Eigen::VectorXd>(g, m) = buffer_;
+    });
+  }
+  bool eval_jac_g(Index n, const Number* x, bool, Index, Index nnz, Index* rows, Index* cols, Number* values) override {
+    if (values == nullptr) {
+      for (Index k = 0; k < nnz; ++k) rows[k] = problem_.jacobianRows()[k], cols[k] = problem_.jacobianColumns()[k];
+      return true;
+    }
+    return guarded([&] {
+      ++outcome_.jacobianEvaluations;
+      problem_.jacobianValues(copy(x, n), buffer_);
+      Eigen::Map<Eigen::VectorXd>(values, nnz) = buffer_;
+    });
+  }
+  bool intermediate_callback(Ipopt::AlgorithmMode, Index iteration, Number objective, Number primal, Number dual, Number,
+                             Number, Number, Number, Number, Index, const Ipopt::IpoptData*,
+                             Ipopt::IpoptCalculatedQuantities*) override {
+    IterationReport r;
+    r.iteration = iteration;
+    r.objective = objective;
+    r.violation = primal;
+    r.dualInfeasibility = dual;
+    r.elapsedSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_).count();
+    return !onIteration_ || onIteration_(r);
+  }
+  void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* x, const Number*, const Number*, Index,
+                         const Number*, const Number*, Number objective, const Ipopt::IpoptData*,
+                         Ipopt::IpoptCalculatedQuantities*) override {
+    std::tie(outcome_.status, outcome_.message) = describe(status);
+    outcome_.optimal = status == Ipopt::SUCCESS;
+    outcome_.objective = objective;
+    if (x != nullptr) outcome_.x = copy(x, n);
+  }
+
+ private:
+  static Eigen::VectorXd copy(const Number* x, Index n) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
+  template <class F>
+  bool guarded(F&& f) {
+    // An exception must not cross Ipopt's C++ frames: report it as a failed evaluation.
+    try {
+      f();
+      return true;
+    } catch (const std::exception& e) {
+      if (outcome_.evaluationError.empty()) outcome_.evaluationError = e.what();
+      return false;
+    }
+  }
+
+  NlpProblem& problem_;
+  Eigen::VectorXd start_, xLower_, xUpper_, gLower_, gUpper_, buffer_;
+  IpoptOutcome& outcome_;
+  const std::function<bool(const IterationReport&)>& onIteration_;
+  std::chrono::steady_clock::time_point clock_;
+};
+
+void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
+  bool accepted = false;
+  switch (o.type) {
+    case SolverOption::Type::Integer:
+      // Ipopt also takes integers for its numeric options (tol: 1).
+      accepted = app.Options()->SetIntegerValue(o.name, o.integer) || app.Options()->SetNumericValue(o.name, o.integer);
+      break;
+    case SolverOption::Type::Number: accepted = app.Options()->SetNumericValue(o.name, o.number); break;
+    case SolverOption::Type::Text: accepted = app.Options()->SetStringValue(o.name, o.text); break;
+  }
+  if (!accepted)
+    throw InputError(o.origin + "Ipopt rejects option '" + o.name + "' = " + o.text +
+                     " (unknown option, wrong type or out of range; see Ipopt's option list)");
+}
+
+}  // namespace
+
+IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, const IpoptSettings& settings,
+                            const std::function<bool(const IterationReport&)>& onIteration) {
+  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+  app->RethrowNonIpoptException(false);
+  // Ours first (formulation.md §10); the scenario's options override them.
+  app->Options()->SetIntegerValue("print_level", settings.printLevel);
+  app->Options()->SetStringValue("sb", "yes");
+  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetNumericValue("tol", 1e-6);
+  app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
+  app->Options()->SetIntegerValue("max_iter", 3000);
+  // MUMPS's maximum-transversal permutation made each factorisation of the motion problem's
+  // KKT system 5× slower (0.5 s against 0.1 s an iteration, HRP-2 kick; docs/scenarios.md).
+  app->Options()->SetIntegerValue("mumps_permuting_scaling", 0);
+  for (const SolverOption& o : settings.options) apply(*app, o);
+  if (app->Initialize() != Ipopt::Solve_Succeeded) throw InputError("Ipopt could not be initialised");
+
+  IpoptOutcome outcome;
+  const auto clock = std::chrono::steady_clock::now();
+  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new ProblemTnlp(problem, start, outcome, onIteration);
+  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
+  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
+  const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
+  if (Ipopt::IsValid(statistics)) outcome.iterations = statistics->IterationCount();
+  if (outcome.status.empty()) {
+    outcome.status = status == Ipopt::Invalid_Option ? "invalid_option" : "internal_error";
+    outcome.message = "Ipopt stopped before it had an iterate (return code " + std::to_string(static_cast<int>(status)) + ")";
+  }
+  return outcome;
+}
+
+}  // namespace mcopt

@@ -1,0 +1,47 @@
+#pragma once
+// Solves an NlpProblem with Ipopt (formulation.md §10): exact first derivatives, the
+// declared sparse Jacobian, a limited-memory Hessian unless the options say otherwise,
+// the scenario's options on top of ours, a report after every iteration (which can stop
+// the solve), and an outcome that always carries the last iterate Ipopt handed back.
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "outer_nlp/nlp_problem.hpp"
+#include "outer_nlp/scenario.hpp"
+
+namespace mcopt {
+
+struct IterationReport {
+  int iteration = 0;
+  double objective = 0.0;
+  double violation = 0.0;      ///< Ipopt's primal infeasibility (of the scaled problem's unscaled rows)
+  double dualInfeasibility = 0.0;
+  double elapsedSeconds = 0.0;
+};
+
+struct IpoptOutcome {
+  std::string status;          ///< optimal, acceptable, maximum_iterations, interrupted, infeasible, …
+  std::string message;         ///< Ipopt's words, e.g. "Optimal Solution Found"
+  bool optimal = false;        ///< Ipopt's SUCCESS
+  Eigen::VectorXd x;           ///< the iterate handed back by Ipopt (empty when it never got one)
+  double objective = 0.0;
+  int iterations = 0;
+  int objectiveEvaluations = 0, gradientEvaluations = 0, constraintEvaluations = 0, jacobianEvaluations = 0;
+  double seconds = 0.0;
+  std::string evaluationError; ///< the first exception a callback raised, if any
+};
+
+struct IpoptSettings {
+  std::vector<SolverOption> options;   ///< applied after ours, in order
+  int printLevel = 0;                  ///< Ipopt's console output (ours is the progress line)
+};
+
+/// Returns false from `onIteration` to stop (Ipopt then reports "interrupted").
+/// Throws InputError naming the scenario line when Ipopt rejects an option.
+IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, const IpoptSettings& settings,
+                            const std::function<bool(const IterationReport&)>& onIteration);
+
+}  // namespace mcopt

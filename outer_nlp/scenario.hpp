@@ -1,0 +1,91 @@
+#pragma once
+// A motion-optimisation scenario (docs/scenarios.md): the robot and its side files, the
+// reference body, the contacts, the duration and samples, the objective, the limits, the
+// tasks, the initialisation and Ipopt's options (formulation.md §10). loadScenario
+// validates everything and names file, line and field in every error.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/actuators.hpp"
+#include "core/robot_files.hpp"
+#include "core/robot_model.hpp"
+
+namespace mcopt {
+
+enum class EnergyForm {
+  SmoothMaximum,  ///< P⁺ ≈ (P + sqrt(P² + ε²)) / 2 (formulation.md §6)
+  Epigraph,       ///< slack s ≥ P, s ≥ 0 per joint and sample; minimise the trapezoid sum of s
+};
+
+enum class TaskKind { Position, Orientation, LinearVelocity, AngularVelocity, CenterOfMass };
+
+/// Bounds on a 3-vector task quantity; ±∞ where a component is free.
+struct TaskSpec {
+  std::string name;          ///< from the file, or "tasks[i]"
+  std::string origin;        ///< "file:line" of the task, for messages
+  TaskKind kind = TaskKind::Position;
+  std::string body;          ///< URDF link (empty for the centre of mass)
+  int frame = -1;            ///< RobotModel frame of `body`
+  Vector3 point = Vector3::Zero();       ///< in the body frame (position, linear velocity)
+  Matrix3 targetRotation = Matrix3::Identity();  ///< orientation tasks: the error is measured from it
+  double start = 0.0, end = 0.0;         ///< instant (start == end) or window [s], of the initial duration
+  bool window = false;
+  Eigen::Vector3d lower = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
+  Eigen::Vector3d upper = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+};
+
+struct DurationSpec {
+  double initial = 1.0;  ///< [s]
+  double lower = 1.0, upper = 1.0;
+  bool free() const { return lower < upper; }
+};
+
+/// An Ipopt option as written in the scenario (type decided by the YAML scalar).
+struct SolverOption {
+  enum class Type { Integer, Number, Text } type = Type::Text;
+  std::string name, text, origin;
+  double number = 0.0;
+  int integer = 0;
+};
+
+struct Scenario {
+  std::filesystem::path file;
+  std::string description;
+  RobotModel robot;
+  ActuatorSet actuators;
+  std::string referenceBody;
+  RigidTransform referencePose;
+  Vector3 gravity{0.0, 0.0, -9.81};
+  ContactSurface support;          ///< the reference body's contact surface (the only contact for now)
+  bool contactConstraints = true;  ///< unilaterality, friction cone and CoP of W0 at the samples
+  double minimumNormalForce = 0.0; ///< f_z ≥ this [N]
+
+  DurationSpec duration;
+  int samples = 100;
+  int controlPoints = 9;
+  int outputSamples = 500;         ///< fine resampling of the result (power per joint, energy check)
+
+  EnergyForm energyForm = EnergyForm::SmoothMaximum;
+  double smoothing = 1.0;          ///< ε of the smooth maximum [W]
+
+  bool positionLimits = true, velocityLimits = true, torqueLimits = true;
+  std::vector<TaskSpec> tasks;
+
+  Eigen::VectorXd start, end;      ///< initial guesses for the start and end postures [rad]
+  bool fixStart = false, fixEnd = false;
+  bool configurationOptimisation = true;
+  int configurationIterations = 500;
+
+  std::vector<SolverOption> solverOptions;
+};
+
+/// Reads and validates a scenario file (robot files are loaded relative to it). Throws
+/// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints
+/// or postures, and impossible numbers.
+Scenario loadScenario(const std::filesystem::path& file);
+
+}  // namespace mcopt

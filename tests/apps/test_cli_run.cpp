@@ -1,0 +1,188 @@
+// `mcopt run` as a user meets it (issue 7, docs/scenarios.md): Ipopt's derivative checker on
+// the bundled scenario, the result files, torques reproduced by `mcopt dynamics`, an
+// interrupted run, and a message naming file, line and field for every class of bad input.
+#include <yaml-cpp/yaml.h>
+
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/run_command.hpp"
+#include "common/temp_dir.hpp"
+#include "common/test_support.hpp"
+
+using namespace mcopt;
+using Catch::Matchers::Contains;
+using Json = nlohmann::json;
+
+namespace {
+
+const std::filesystem::path kKick = test::sourceDir() / "scenarios/hrp2_kick.yaml";
+
+/// The bundled kick with its side files made absolute, then `edit` applied, written to dir.
+std::filesystem::path kickVariant(const test::TempDir& dir, const std::function<void(YAML::Node&)>& edit,
+                                  const std::string& name = "scenario.yaml") {
+  YAML::Node root = YAML::LoadFile(kKick.string());
+  for (const char* key : {"robot", "actuators", "contact_surfaces", "postures"})
+    root[key] = (kKick.parent_path() / root[key].as<std::string>()).lexically_normal().string();
+  edit(root);
+  YAML::Emitter out;
+  out << root;
+  return dir.write(name, std::string(out.c_str()) + "\n");
+}
+
+Json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return Json::parse(in);
+}
+
+}  // namespace
+
+TEST_CASE("run: Ipopt's derivative checker finds no error on the bundled scenario", "[cli][run]") {
+  // Forward differences: Ipopt's default step 1e-8 is below the objective's round-off (an
+  // energy summed over 3000 powers) and 1e-6 above its curvature; 1e-7 resolves both
+  // (docs/scenarios.md). Checked at the scenario's own start and after configuration
+  // optimisation (a posture with CoM over the sole). Ipopt 3.11's checker costs time
+  // quadratic in the Jacobian (40 s at 100 samples): 25 samples here, every kind of row
+  // still present; tests/outer_nlp checks the full sampling against central differences.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 25;
+    root["solver"] = YAML::Node();
+    root["solver"]["max_iter"] = 0;
+    root["solver"]["derivative_test"] = "first-order";
+    root["solver"]["derivative_test_perturbation"] = 1e-7;
+    root["solver"]["print_level"] = 5;
+  });
+  for (const char* initialisation : {"off", "on"}) {
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(dir.path() / "out") +
+                                  " --configuration-optimisation " + initialisation);
+    INFO(r.output.substr(0, 4000));
+    CHECK_THAT(r.output, Contains("Starting derivative checker for first derivatives"));
+    CHECK_THAT(r.output, Contains("No errors detected by derivative checker"));
+  }
+}
+
+TEST_CASE("run: result files, their fields, and torques that mcopt dynamics reproduces", "[cli][run]") {
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) { root["samples"] = 40; });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 15");
+  INFO(r.all());
+  REQUIRE(r.exitCode == 4);  // stopped by the iteration limit: not optimal
+  CHECK_THAT(r.output, Contains("configuration optimisation") && Contains("EXIT: Maximum Number of Iterations Exceeded"));
+  CHECK(r.output.find("     15  ") != std::string::npos);  // a progress line per iteration
+  const Json result = readJson(out / "result.json");
+  CHECK(result["status"] == "maximum_iterations");
+  CHECK(result["energy"].get<double>() > 0.0);
+  CHECK(result["max_violation"].get<double>() >= 0.0);
+  CHECK_THAT(result["reason"].get<std::string>(), Contains("Maximum Number of Iterations"));
+  for (const char* key : {"parameters", "time", "q", "v", "a", "torques", "contact_wrench", "center_of_pressure",
+                          "power", "power_fine", "violation_by_kind", "solver", "timings", "configuration_optimisation"})
+    CHECK(result.contains(key));
+  CHECK(result["q"].size() == 40);
+  CHECK(result["power_fine"]["power"].size() == 500);
+  CHECK(result["solver"]["iterations"] == 15);
+  CHECK(result["configuration_optimisation"]["start"]["optimised"] == true);
+  for (const char* file : {"trajectory.csv", "power_fine.csv", "states.json"}) CHECK(std::filesystem::exists(out / file));
+
+  // The states, re-evaluated by `mcopt dynamics`, give the result's torques.
+  const auto dynamics = test::runMcopt("dynamics --robot " + test::quoted(test::sourceDir() / "robots/hrp2/hrp2.urdf") +
+                                       " --reference-body l_sole --states " + test::quoted(out / "states.json") +
+                                       " --out " + test::quoted(dir.path() / "dynamics.json"));
+  REQUIRE(dynamics.exitCode == 0);
+  const Json evaluated = readJson(dir.path() / "dynamics.json");
+  REQUIRE(evaluated["results"].size() == 40);
+  double worst = 0.0, largest = 0.0;
+  for (std::size_t s = 0; s < 40; ++s)
+    for (std::size_t j = 0; j < 30; ++j) {
+      const double expected = result["torques"][s][j].get<double>();
+      worst = std::max(worst, std::abs(evaluated["results"][s]["tau"][j].get<double>() - expected));
+      largest = std::max(largest, std::abs(expected));
+    }
+  INFO("largest torque " << largest << " N m, worst difference " << worst);
+  CHECK(largest > 10.0);
+  CHECK(worst <= 1e-9 * largest);
+}
+
+TEST_CASE("run: an interrupted run writes its last iterate and exits non-zero", "[cli][run]") {
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) { root["solver"]["max_iter"] = 100000; });
+  const auto out = dir.path() / "out";
+  // SIGINT once Ipopt iterates (configuration optimisation off to get there fast).
+  const std::string command = "( " + std::string(MCOPT_EXECUTABLE) + " run " + test::quoted(scenario) + " --out " +
+                              test::quoted(out) + " --configuration-optimisation off > " +
+                              test::quoted(dir.path() / "log.txt") + " 2>&1 & pid=$!; sleep 4; kill -INT $pid; wait $pid; echo $? )";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 256> buffer{};
+  std::string exitCode;
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) exitCode += buffer.data();
+  ::pclose(pipe);
+  CHECK(std::stoi(exitCode) == 130);
+  const Json result = readJson(out / "result.json");
+  CHECK(result["status"] == "interrupted");
+  CHECK_THAT(result["reason"].get<std::string>(), Contains("interrupted"));
+  CHECK(result["solver"]["iterations"].get<int>() > 0);
+  CHECK(result["q"].size() == 100);
+}
+
+TEST_CASE("run: every class of bad scenario is refused with file, line and field", "[cli][run]") {
+  const test::TempDir dir;
+  struct Case {
+    const char* what;
+    std::function<void(YAML::Node&)> edit;
+    std::vector<std::string> expected;  ///< fragments of the message
+  };
+  const std::vector<Case> cases = {
+      {"unknown key", [](YAML::Node& r) { r["sampels"] = 10; }, {"sampels: unknown key"}},
+      {"wrong type", [](YAML::Node& r) { r["samples"] = "many"; }, {"samples: expected a number"}},
+      {"not an integer", [](YAML::Node& r) { r["samples"] = 1.5; }, {"samples: expected an integer ≥ 2"}},
+      {"impossible duration", [](YAML::Node& r) { r["duration"] = -1.0; }, {"duration: must be positive"}},
+      {"duration bounds", [](YAML::Node& r) {
+         r["duration"] = YAML::Load("{initial: 3.0, min: 1.0, max: 2.0}");
+       }, {"duration: expected min ≤ initial ≤ max"}},
+      {"unknown reference body", [](YAML::Node& r) { r["reference_body"] = "l_foot_typo"; },
+       {"reference_body: unknown body 'l_foot_typo'"}},
+      {"unknown task body", [](YAML::Node& r) { r["tasks"][0]["body"] = "r_hoof"; }, {"tasks[0].body: unknown body 'r_hoof'"}},
+      {"unknown task kind", [](YAML::Node& r) { r["tasks"][0]["kind"] = "acceleration"; },
+       {"tasks[0].kind: unknown task kind 'acceleration'"}},
+      {"task after the end", [](YAML::Node& r) { r["tasks"][0]["time"] = 9.0; }, {"tasks[0].time: after the end"}},
+      {"reversed window", [](YAML::Node& r) { r["tasks"][1]["window"] = YAML::Load("[1.0, 0.5]"); },
+       {"tasks[1].window: expected [start, end]"}},
+      {"task bounding nothing", [](YAML::Node& r) { r["tasks"][0]["target"] = YAML::Load("[null, null, null]"); },
+       {"the task bounds nothing"}},
+      {"unknown joint", [](YAML::Node& r) { r["start"]["offsets"]["KNEE"] = 0.1; }, {"start.offsets.KNEE: unknown joint"}},
+      {"unknown posture", [](YAML::Node& r) { r["end"]["posture"] = "crouch"; }, {"end.posture: unknown posture 'crouch'"}},
+      {"posture outside the limits", [](YAML::Node& r) { r["start"]["offsets"]["RLEG_JOINT3"] = 5.0; },
+       {"start: joint RLEG_JOINT3", "outside its limits"}},
+      {"unknown contact", [](YAML::Node& r) { r["contacts"][0] = "l_knee"; }, {"contacts[0]: unknown contact surface 'l_knee'"}},
+      {"contact off the reference body", [](YAML::Node& r) { r["contacts"][0] = "r_sole"; },
+       {"contacts[0]: contact 'r_sole' is not on the reference body"}},
+      {"several contacts", [](YAML::Node& r) { r["contacts"].push_back("r_hand"); }, {"contacts[1]: mcopt run handles one contact"}},
+      {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
+       {"actuators: file not found"}},
+      {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},
+      {"missing field", [](YAML::Node& r) { r.remove("duration"); }, {"duration: missing required field"}},
+      {"unknown Ipopt option", [](YAML::Node& r) { r["solver"]["max_iterations"] = 10; },
+       {"solver.max_iterations: Ipopt rejects option 'max_iterations'"}},
+      {"Ipopt option out of range", [](YAML::Node& r) { r["solver"]["tol"] = -1.0; }, {"solver.tol: Ipopt rejects option 'tol'"}},
+  };
+  for (const Case& c : cases) {
+    const auto file = kickVariant(dir, c.edit, "bad.yaml");
+    const auto r = test::runMcopt("run " + test::quoted(file) + " --out " + test::quoted(dir.path() / "never"));
+    INFO(c.what << ": " << r.all());
+    CHECK(r.exitCode == 2);
+    // "file:LINE: field: what"
+    const auto at = r.errors.find(file.string() + ":");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::isdigit(static_cast<unsigned char>(r.errors[at + file.string().size() + 1])));
+    for (const std::string& fragment : c.expected) CHECK_THAT(r.errors, Contains(fragment));
+    CHECK_FALSE(std::filesystem::exists(dir.path() / "never" / "result.json"));
+  }
+  // Malformed YAML names the line.
+  const auto malformed = dir.write("malformed.yaml", "robot: a.urdf\nsamples: [1, 2\n");
+  const auto r = test::runMcopt("run " + test::quoted(malformed));
+  CHECK(r.exitCode == 2);
+  CHECK_THAT(r.errors, Contains(malformed.string() + ":") && Contains("malformed YAML"));
+}
