@@ -98,10 +98,13 @@ int runMotion(const RunOptions& o) {
   record.configurationSeconds = seconds(configurationClock);
 
   const Eigen::VectorXd x0 = problem.initialPoint(start, end);
-  std::cout << "motion optimisation (Ipopt, limited-memory Hessian)\n"
+  std::cout << "motion optimisation (Ipopt, "
+            << (scenario.finiteDifferenceHessian ? "Hessian by differences of exact gradients" : "limited-memory Hessian")
+            << ")\n"
             << "   iter      energy [J]   violation   dual inf.     elapsed\n";
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
+  settings.finiteDifferenceHessian = scenario.finiteDifferenceHessian;
   const auto optimisationClock = std::chrono::steady_clock::now();
   record.solver = solveWithIpopt(problem, x0, settings, [](const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s\n", r.iteration, r.objective, r.violation, r.dualInfeasibility,

@@ -11,9 +11,10 @@ namespace mcopt::cli {
 
 namespace {
 
-using json_io::Json;
-using json_io::matrixToJson;
-using json_io::toJson;
+// Insertion order kept: status, energy and max_violation lead result.json.
+using Json = nlohmann::ordered_json;
+Json toJson(const Eigen::Ref<const Eigen::VectorXd>& v) { return Json(json_io::toJson(v)); }
+Json matrixToJson(const Eigen::Ref<const Eigen::MatrixXd>& m) { return Json(json_io::matrixToJson(m)); }
 
 Json posture(const PostureOutcome& p) {
   Json j;

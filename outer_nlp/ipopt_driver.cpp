@@ -40,9 +40,9 @@ std::pair<std::string, std::string> describe(Ipopt::SolverReturn status) {
 class ProblemTnlp final : public Ipopt::TNLP {
  public:
   ProblemTnlp(NlpProblem& problem, const Eigen::VectorXd& start, IpoptOutcome& outcome,
-              const std::function<bool(const IterationReport&)>& onIteration)
+              const std::function<bool(const IterationReport&)>& onIteration, bool hessian)
       : problem_(problem), start_(start), outcome_(outcome), onIteration_(onIteration),
-        clock_(std::chrono::steady_clock::now()) {
+        clock_(std::chrono::steady_clock::now()), hessian_(hessian) {
     problem_.variableBounds(xLower_, xUpper_);
     problem_.constraintBounds(gLower_, gUpper_);
   }
@@ -51,7 +51,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
     n = problem_.variableCount();
     m = problem_.constraintCount();
     nnzJacobian = static_cast<Index>(problem_.jacobianRows().size());
-    nnzHessian = 0;  // limited-memory Hessian
+    const Index curved = problem_.nonlinearVariableCount();
+    nnzHessian = hessian_ ? curved * (curved + 1) / 2 : 0;  // dense lower triangle, or limited memory
     style = C_STYLE;
     return true;
   }
@@ -98,6 +99,35 @@ class ProblemTnlp final : public Ipopt::TNLP {
       Eigen::Map<Eigen::VectorXd>(values, nnz) = buffer_;
     });
   }
+  bool eval_h(Index n, const Number* x, bool, Number objectiveFactor, Index m, const Number* lambda, bool, Index,
+              Index* rows, Index* cols, Number* values) override {
+    const Index curved = problem_.nonlinearVariableCount();
+    if (values == nullptr) {
+      Index k = 0;
+      for (Index r = 0; r < curved; ++r)
+        for (Index c = 0; c <= r; ++c) rows[k] = r, cols[k] = c, ++k;
+      return true;
+    }
+    return guarded([&] {
+      // Column c = (∇L(x + h e_c) − ∇L(x)) / h, ∇L = σ ∇f + Jᵀ λ, then symmetrised. Forward
+      // differences: half the evaluations of central ones, and Newton's steps do not need
+      // more than their ~1e-6 relative accuracy (h = 1e-6 balances truncation and round-off).
+      const Eigen::Map<const Eigen::VectorXd> multipliers(lambda, m);
+      Eigen::VectorXd point = copy(x, n), base, plus;
+      lagrangianGradient(point, objectiveFactor, multipliers, base);
+      Eigen::MatrixXd columns(curved, curved);
+      for (Index c = 0; c < curved; ++c) {
+        const double saved = point[c], h = 1e-6 * std::max(1.0, std::abs(saved));
+        point[c] = saved + h;
+        lagrangianGradient(point, objectiveFactor, multipliers, plus);
+        point[c] = saved;
+        columns.col(c) = (plus - base).head(curved) / h;
+      }
+      Index k = 0;
+      for (Index r = 0; r < curved; ++r)
+        for (Index c = 0; c <= r; ++c) values[k++] = 0.5 * (columns(r, c) + columns(c, r));
+    });
+  }
   bool intermediate_callback(Ipopt::AlgorithmMode, Index iteration, Number objective, Number primal, Number dual, Number,
                              Number, Number, Number, Number, Index, const Ipopt::IpoptData*,
                              Ipopt::IpoptCalculatedQuantities*) override {
@@ -119,6 +149,15 @@ class ProblemTnlp final : public Ipopt::TNLP {
   }
 
  private:
+  void lagrangianGradient(const Eigen::VectorXd& x, double objectiveFactor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
+                          Eigen::VectorXd& out) {
+    problem_.objectiveGradient(x, out);
+    out *= objectiveFactor;
+    problem_.jacobianValues(x, jacobian_);
+    const Eigen::VectorXi& rows = problem_.jacobianRows();
+    const Eigen::VectorXi& cols = problem_.jacobianColumns();
+    for (Eigen::Index k = 0; k < jacobian_.size(); ++k) out[cols[k]] += jacobian_[k] * lambda[rows[k]];
+  }
   static Eigen::VectorXd copy(const Number* x, Index n) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
   template <class F>
   bool guarded(F&& f) {
@@ -137,6 +176,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
   IpoptOutcome& outcome_;
   const std::function<bool(const IterationReport&)>& onIteration_;
   std::chrono::steady_clock::time_point clock_;
+  bool hessian_;
+  Eigen::VectorXd jacobian_;
 };
 
 void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
@@ -163,7 +204,8 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
   // Ours first (formulation.md §10); the scenario's options override them.
   app->Options()->SetIntegerValue("print_level", settings.printLevel);
   app->Options()->SetStringValue("sb", "yes");
-  app->Options()->SetStringValue("hessian_approximation", "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation",
+                                 settings.finiteDifferenceHessian ? "exact" : "limited-memory");
   app->Options()->SetNumericValue("tol", 1e-6);
   app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
   app->Options()->SetIntegerValue("max_iter", 3000);
@@ -175,7 +217,7 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
 
   IpoptOutcome outcome;
   const auto clock = std::chrono::steady_clock::now();
-  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new ProblemTnlp(problem, start, outcome, onIteration);
+  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new ProblemTnlp(problem, start, outcome, onIteration, settings.finiteDifferenceHessian);
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
   const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();

@@ -295,6 +295,7 @@ void MotionProblem::evaluateSample(int s, double T, bool derivatives, ThreadWork
   else
     inverseDynamics(model_, w.data, w.q, w.v, w.a);
   b.y.head(n) = w.data.tau;
+  b.acceleration = w.a;
 
   Eigen::Matrix<double, 6, 6> rowsByW0;
   if (derivatives)
@@ -372,6 +373,8 @@ double MotionProblem::objective(const Eigen::VectorXd& x) {
       sum = x.segment(slackStart_ + s * n, n).sum();
     else
       for (int j = 0; j < n; ++j) sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[n + 6 + j], scenario_.smoothing);
+    if (scenario_.accelerationWeight > 0.0)
+      sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration.squaredNorm();
     energy += weight * sum;
   }
   return energy;
@@ -379,19 +382,32 @@ double MotionProblem::objective(const Eigen::VectorXd& x) {
 
 void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
   const bool epigraph = scenario_.energyForm == EnergyForm::Epigraph;
-  if (!epigraph) evaluate(x, true);
+  if (!epigraph)
+    evaluate(x, true);
+  else if (scenario_.accelerationWeight > 0.0)
+    evaluate(x, false);
   const int N = samples_.sampleCount(), n = jointCount_;
   const double T = duration(x), dt = T / (N - 1);
   gradient.setZero(variableCount_);
   double dT = 0.0;
   for (int s = 0; s < N; ++s) {
     const double weight = (s == 0 || s == N - 1) ? 0.5 * dt : dt;
+    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+    if (scenario_.accelerationWeight > 0.0) {
+      // ∂q̈_j/∂x_{j,l} = w''_l / T², ∂q̈/∂T = −2 q̈ / T; the weight Δt ∝ T.
+      const LocalParameterWeights& local = samples_.weights(s);
+      const double scale = weight * scenario_.accelerationWeight;
+      const int m = parametrization_.parametersPerJoint();
+      for (int j = 0; j < n; ++j)
+        for (int l = 0; l < local.count; ++l)
+          gradient[j * m + local.parameter[l]] += scale * 2.0 * b.acceleration[j] * local.d2[l] / (T * T);
+      dT += scale * (b.acceleration.squaredNorm() / T - 4.0 * b.acceleration.squaredNorm() / T);
+    }
     if (epigraph) {
-      gradient.segment(slackStart_ + s * n, n).setConstant(weight);
+      gradient.segment(slackStart_ + s * n, n).array() += weight;
       dT += weight / T * x.segment(slackStart_ + s * n, n).sum();
       continue;
     }
-    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
     for (int j = 0; j < n; ++j) {
       const double p = b.y[n + 6 + j], slope = weight * smoothMaximumSlope(p, scenario_.smoothing);
       for (Eigen::Index c = 0; c < b.parameters.size(); ++c) gradient[b.parameters[c]] += slope * b.dyDx(n + 6 + j, c);

@@ -17,7 +17,8 @@
 // which is the declared sparsity (B-spline local support).
 //
 // Objective: E = Σ_s c_s Δt Σ_j P⁺_js, Δt = T/(N − 1), trapezoid weights c_s, with P⁺
-// the smooth maximum (P + sqrt(P² + ε²))/2 or the epigraph slack (formulation.md §6).
+// the smooth maximum (P + sqrt(P² + ε²))/2 or the epigraph slack (formulation.md §6), plus
+// the scenario's regularisation w Σ_s c_s Δt Σ_j q̈_js² (formulation.md §10; 0 by default).
 
 #include <Eigen/Core>
 #include <string>
@@ -49,6 +50,7 @@ class MotionProblem final : public NlpProblem {
   bool durationIsFree() const { return scenario_.duration.free(); }
 
   int variableCount() const override { return variableCount_; }
+  int nonlinearVariableCount() const override { return slackStart_; }
   int constraintCount() const override { return static_cast<int>(rowKind_.size()); }
   int jacobianNonZeros() const { return static_cast<int>(jacobianRows_.size()); }
   const Eigen::VectorXi& jacobianRows() const override { return jacobianRows_; }
@@ -85,6 +87,7 @@ class MotionProblem final : public NlpProblem {
  private:
   struct SampleBlock {
     Eigen::VectorXd y;        ///< [Γ0 (n), contact rows (6), power (n)]
+    Eigen::VectorXd acceleration;  ///< q̈ (n), for the regularisation
     Eigen::MatrixXd dyDx;     ///< rows × local parameters
     Eigen::VectorXd dyDT;
     Eigen::VectorXi parameters;

@@ -22,6 +22,9 @@ class NlpProblem {
   virtual void objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) = 0;
   virtual void constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) = 0;
   virtual void jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& values) = 0;
+  /// Variables [0, n) that enter f or g nonlinearly (the rest, e.g. epigraph slacks, enter
+  /// linearly): the block a finite-difference Hessian has to fill.
+  virtual int nonlinearVariableCount() const { return variableCount(); }
   /// A readable name of constraint row `row`, for messages.
   virtual std::string rowName(int row) const = 0;
 };

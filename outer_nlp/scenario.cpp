@@ -193,7 +193,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "solver"});
+                           "initialisation", "hessian", "solver"});
   Scenario s;
   s.file = file;
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
@@ -260,7 +260,9 @@ Scenario loadScenario(const std::filesystem::path& file) {
 
   if (root["objective"]) {
     const YAML::Node o = root["objective"];
-    yaml::rejectUnknownKeys(file, o, "objective", {"energy", "smoothing"});
+    yaml::rejectUnknownKeys(file, o, "objective", {"energy", "smoothing", "acceleration_weight"});
+    if (o["acceleration_weight"])
+      s.accelerationWeight = yaml::nonNegative(file, o["acceleration_weight"], "objective.acceleration_weight");
     if (o["energy"]) {
       const std::string form = yaml::text(file, o["energy"], "objective.energy");
       if (form == "smooth_max") s.energyForm = EnergyForm::SmoothMaximum;
@@ -313,6 +315,13 @@ Scenario loadScenario(const std::filesystem::path& file) {
     if (init["configuration_iterations"])
       s.configurationIterations =
           integerField(file, init["configuration_iterations"], "initialisation.configuration_iterations", 1);
+  }
+  if (root["hessian"]) {
+    const std::string hessian = yaml::text(file, root["hessian"], "hessian");
+    if (hessian != "limited-memory" && hessian != "finite-differences")
+      throw InputError(where(file, root["hessian"], "hessian") + "expected limited-memory or finite-differences, got '" +
+                       hessian + "'");
+    s.finiteDifferenceHessian = hessian == "finite-differences";
   }
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   return s;

@@ -71,6 +71,7 @@ struct Scenario {
 
   EnergyForm energyForm = EnergyForm::SmoothMaximum;
   double smoothing = 1.0;          ///< ε of the smooth maximum [W]
+  double accelerationWeight = 0.0; ///< w of the regularisation w ∫ Σ_j q̈_j² dt [J s⁴/rad²/s]
 
   bool positionLimits = true, velocityLimits = true, torqueLimits = true;
   std::vector<TaskSpec> tasks;
@@ -81,6 +82,7 @@ struct Scenario {
   int configurationIterations = 500;
 
   std::vector<SolverOption> solverOptions;
+  bool finiteDifferenceHessian = false;  ///< hessian: finite-differences (else limited-memory)
 };
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds mcopt (Release) and runs the main job on the
-# bundled HRP-2 scenario. Extra arguments go to `mcopt`, e.g. `scripts/run.sh evaluate X.yaml`.
+# bundled HRP-2 scenario. Extra arguments go to `mcopt`, e.g. `scripts/run.sh run X.yaml`.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 "$root/scripts/install-deps.sh"
 cmake --preset release -S "$root" >/dev/null
 cmake --build "$root/build/release" --target mcopt
 if [ $# -eq 0 ]; then
-  set -- evaluate "$root/scenarios/hrp2_arm_raise.yaml" --out "$root/out/hrp2_arm_raise"
+  set -- run "$root/scenarios/hrp2_kick.yaml" --out "$root/out/hrp2_kick"
 fi
 exec "$root/build/release/apps/mcopt" "$@"

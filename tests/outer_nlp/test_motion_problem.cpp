@@ -79,6 +79,15 @@ TEST_CASE("outer problem: exact gradient and sparse Jacobian agree with central 
     const Eigen::VectorXd x0 = problem.initialPoint(scenario.start, scenario.end);
     checkDerivatives(problem, perturbed(x0, problem.parametrization().parameterCount(), 0.2, 1), 1e-6, 1e-6);
   }
+  SECTION("smooth maximum and acceleration regularisation, free duration") {
+    scenario.accelerationWeight = 1e-3;
+    scenario.duration.lower = 1.0, scenario.duration.upper = 2.5;
+    MotionProblem problem(scenario);
+    Eigen::VectorXd x0 = problem.initialPoint(scenario.start, scenario.end);
+    x0 = perturbed(x0, problem.parametrization().parameterCount(), 0.2, 4);
+    x0[problem.parametrization().parameterCount()] = 1.3;
+    checkDerivatives(problem, x0, 1e-6, 1e-6);
+  }
   SECTION("smooth maximum, at rest") {
     MotionProblem problem(scenario);
     const Eigen::VectorXd x0 = problem.initialPoint(scenario.start, scenario.end);
@@ -86,6 +95,7 @@ TEST_CASE("outer problem: exact gradient and sparse Jacobian agree with central 
   }
   SECTION("epigraph, free duration") {
     scenario.energyForm = EnergyForm::Epigraph;
+    scenario.accelerationWeight = 1e-3;
     scenario.duration.lower = 1.0, scenario.duration.upper = 2.5;
     MotionProblem problem(scenario);
     REQUIRE(problem.durationIsFree());
