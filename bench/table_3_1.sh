@@ -15,7 +15,7 @@ scenario="$root/scenarios/hrp2_kick.yaml"
 sed -e 's/^hessian: finite-differences/hessian: limited-memory/' \
     -e "s#\.\./robots#$root/robots#g" "$scenario" > "$out/hrp2_kick_lbfgs.yaml"
 
-field() { sed -n "s/^ \"$2\": \(.*\),\$/\1/p" "$1/result.json" | head -1; }
+field() { sed -n "s/^ \"$2\": \(.*\),\$/\1/p" "$1/result.json" | head -1 | tr -d '"'; }
 timing() { sed -n 's/^  "total_seconds": \(.*\)$/\1/p' "$1/result.json" | head -1; }
 iterations() { sed -n 's/^  "iterations": \(.*\),$/\1/p' "$1/result.json" | tail -1; }
 
