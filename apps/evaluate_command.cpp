@@ -87,22 +87,7 @@ MotionFile readMotionFile(const std::filesystem::path& path) {
 Eigen::VectorXd readPosture(const std::filesystem::path& path, const YAML::Node& node, const std::string& field,
                             const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
   yaml::rejectUnknownKeys(path, node, field, {"posture", "offsets"});
-  const std::string name = yaml::text(path, yaml::required(path, node, "posture", field), field + ".posture");
-  const auto found = postures.find(name);
-  if (found == postures.end())
-    throw InputError(yaml::where(path, node["posture"], field + ".posture") + "unknown posture '" + name + "'");
-  Eigen::VectorXd q = found->second;
-  if (node["offsets"]) {
-    if (!node["offsets"].IsMap())
-      throw InputError(yaml::where(path, node["offsets"], field + ".offsets") + "expected a mapping joint → offset [rad]");
-    for (const auto& entry : node["offsets"]) {
-      const std::string joint = entry.first.as<std::string>();
-      const int j = robot.findJoint(joint);
-      if (j < 0) throw InputError(yaml::where(path, entry.first, field + ".offsets." + joint) + "unknown joint");
-      q[j] += yaml::number(path, entry.second, field + ".offsets." + joint);
-    }
-  }
-  return q;
+  return postureWithOffsets(path, node, field, robot, postures);
 }
 
 std::string trajectoryCsv(const RobotModel& robot, const TrajectoryResult& r) {

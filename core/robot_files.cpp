@@ -71,4 +71,25 @@ std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path&
   return out;
 }
 
+Eigen::VectorXd postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
+                                   const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
+  const YAML::Node nameNode = yaml::required(file, node, "posture", field);
+  const std::string name = yaml::text(file, nameNode, field + ".posture");
+  const auto found = postures.find(name);
+  if (found == postures.end())
+    throw InputError(yaml::where(file, nameNode, field + ".posture") + "unknown posture '" + name + "'");
+  Eigen::VectorXd q = found->second;
+  if (node["offsets"]) {
+    if (!node["offsets"].IsMap())
+      throw InputError(yaml::where(file, node["offsets"], field + ".offsets") + "expected a mapping joint → offset [rad]");
+    for (const auto& entry : node["offsets"]) {
+      const std::string joint = entry.first.as<std::string>();
+      const int j = robot.findJoint(joint);
+      if (j < 0) throw InputError(yaml::where(file, entry.first, field + ".offsets." + joint) + "unknown joint");
+      q[j] += yaml::number(file, entry.second, field + ".offsets." + joint);
+    }
+  }
+  return q;
+}
+
 }  // namespace mcopt

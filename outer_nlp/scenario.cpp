@@ -41,22 +41,7 @@ std::filesystem::path sideFile(const std::filesystem::path& file, const YAML::No
 Eigen::VectorXd readPosture(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
                             const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
   yaml::rejectUnknownKeys(file, node, field, {"posture", "offsets", "fixed"});
-  const YAML::Node nameNode = yaml::required(file, node, "posture", field);
-  const std::string name = yaml::text(file, nameNode, field + ".posture");
-  const auto found = postures.find(name);
-  if (found == postures.end()) throw InputError(where(file, nameNode, field + ".posture") + "unknown posture '" + name + "'");
-  Eigen::VectorXd q = found->second;
-  if (node["offsets"]) {
-    if (!node["offsets"].IsMap())
-      throw InputError(where(file, node["offsets"], field + ".offsets") + "expected a mapping joint → offset [rad]");
-    for (const auto& entry : node["offsets"]) {
-      const std::string joint = entry.first.as<std::string>();
-      const int j = robot.findJoint(joint);
-      if (j < 0) throw InputError(where(file, entry.first, field + ".offsets." + joint) + "unknown joint");
-      q[j] += yaml::number(file, entry.second, field + ".offsets." + joint);
-    }
-  }
-  return q;
+  return postureWithOffsets(file, node, field, robot, postures);
 }
 
 /// Three bounds, each a number or null (free).
@@ -231,8 +216,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
     throw InputError(where(file, contactsNode, "contacts") + "expected a list of contact surface names");
   if (contactsNode.size() > 1)
     throw InputError(where(file, contactsNode[1], "contacts[1]") +
-                     "mcopt run handles one contact (the reference body's) so far; multi-contact outer problems "
-                     "are not implemented yet");
+                     "mcopt run optimises motions on one contact, the reference body's; a second contact makes "
+                     "the problem bilevel (formulation.md §7), which the outer problem does not support");
   const std::string contactName = yaml::text(file, contactsNode[0], "contacts[0]");
   bool found = false;
   for (const ContactSurface& c : surfaces)

@@ -174,7 +174,7 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"unknown contact", [](YAML::Node& r) { r["contacts"][0] = "l_knee"; }, {"contacts[0]: unknown contact surface 'l_knee'"}},
       {"contact off the reference body", [](YAML::Node& r) { r["contacts"][0] = "r_sole"; },
        {"contacts[0]: contact 'r_sole' is not on the reference body"}},
-      {"several contacts", [](YAML::Node& r) { r["contacts"].push_back("r_hand"); }, {"contacts[1]: mcopt run handles one contact"}},
+      {"several contacts", [](YAML::Node& r) { r["contacts"].push_back("r_hand"); }, {"contacts[1]: mcopt run optimises motions on one contact"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},
