@@ -2,7 +2,9 @@
 // optionally optimises the static start and end postures (report §3.5), then optimises the
 // whole motion with Ipopt (formulation.md §10), printing a line per iteration, and writes
 // the results atomically. Ctrl-C (SIGINT) or SIGTERM stops Ipopt at the end of the current
-// iteration; the last iterate is then written with status "interrupted".
+// iteration; the last iterate is then written with status "interrupted". While Ipopt runs,
+// the current iterate is written every --checkpoint-seconds with status "running", so that
+// a run killed outright (SIGKILL, power loss) still leaves its latest complete result.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -28,6 +30,7 @@ struct RunOptions {
   std::string scenario, out = "mcopt-run";
   std::string configurationOptimisation;  ///< "", "on" or "off": overrides the scenario
   int maxIterations = -1;
+  double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
 };
 
 constexpr int kExitNotOptimal = 4;
@@ -59,6 +62,31 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
             << " iterations, static power " << std::setprecision(4) << outcome.staticPowerBefore << " → "
             << outcome.staticPowerAfter << " W (" << std::setprecision(3) << result.seconds << " s)\n";
   return usable ? result.x : guess;
+}
+
+/// The run so far, written as its result with status "running": what a killed run leaves.
+/// A failed write costs the checkpoint, not the run (it is reported and Ipopt goes on).
+void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRecord& sofar, const IterationReport& r,
+                     double optimisationSeconds, double totalSeconds) {
+  RunRecord checkpoint = sofar;
+  checkpoint.status = "running";
+  checkpoint.message = "Ipopt was running when this was written";
+  checkpoint.reason = "checkpoint after iteration " + std::to_string(r.iteration) +
+                      "; the run had not ended (a run that ends overwrites it)";
+  checkpoint.x = *r.iterate;
+  if (r.progress != nullptr) checkpoint.solver = *r.progress;
+  checkpoint.solver.status = checkpoint.status;
+  checkpoint.solver.message = checkpoint.message;
+  checkpoint.solver.iterations = r.iteration;
+  checkpoint.solver.objective = r.objective;
+  checkpoint.solver.x = *r.iterate;
+  checkpoint.optimisationSeconds = optimisationSeconds;
+  checkpoint.totalSeconds = totalSeconds;
+  try {
+    writeRunOutput(out, problem, checkpoint);
+  } catch (const std::exception& e) {
+    std::cerr << "mcopt: warning: checkpoint after iteration " << r.iteration << " not written: " << e.what() << "\n";
+  }
 }
 
 int runMotion(const RunOptions& o) {
@@ -106,10 +134,16 @@ int runMotion(const RunOptions& o) {
   settings.options = scenario.solverOptions;
   settings.finiteDifferenceHessian = scenario.finiteDifferenceHessian;
   const auto optimisationClock = std::chrono::steady_clock::now();
-  record.solver = solveWithIpopt(problem, x0, settings, [](const IterationReport& r) {
+  double lastCheckpoint = 0.0;
+  record.solver = solveWithIpopt(problem, x0, settings, [&](const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s\n", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
     std::fflush(stdout);
+    if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
+        r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
+      writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
+      lastCheckpoint = r.elapsedSeconds;
+    }
     return stopRequested == 0;
   });
   record.optimisationSeconds = seconds(optimisationClock);
@@ -150,6 +184,10 @@ Runner addRun(CLI::App& command) {
                      "on or off: override the scenario's initialisation.configuration_optimisation")
       ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--max-iterations", o->maxIterations, "override Ipopt's max_iter for the motion");
+  command.add_option("--checkpoint-seconds", o->checkpointSeconds,
+                     "write the current iterate (status running) at most this often; 0: every iteration, "
+                     "negative: never")
+      ->capture_default_str();
   return [o] { return runMotion(*o); };
 }
 

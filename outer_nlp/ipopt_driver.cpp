@@ -1,8 +1,12 @@
 #include "outer_nlp/ipopt_driver.hpp"
 
 #include <IpIpoptApplication.hpp>
+#include <IpIpoptCalculatedQuantities.hpp>
+#include <IpIpoptData.hpp>
+#include <IpOrigIpoptNLP.hpp>
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
+#include <IpTNLPAdapter.hpp>
 
 #include <chrono>
 
@@ -128,15 +132,18 @@ class ProblemTnlp final : public Ipopt::TNLP {
         for (Index c = 0; c <= r; ++c) values[k++] = 0.5 * (columns(r, c) + columns(c, r));
     });
   }
-  bool intermediate_callback(Ipopt::AlgorithmMode, Index iteration, Number objective, Number primal, Number dual, Number,
-                             Number, Number, Number, Number, Index, const Ipopt::IpoptData*,
-                             Ipopt::IpoptCalculatedQuantities*) override {
+  bool intermediate_callback(Ipopt::AlgorithmMode mode, Index iteration, Number objective, Number primal, Number dual,
+                             Number, Number, Number, Number, Number, Index, const Ipopt::IpoptData* data,
+                             Ipopt::IpoptCalculatedQuantities* quantities) override {
     IterationReport r;
     r.iteration = iteration;
     r.objective = objective;
     r.violation = primal;
     r.dualInfeasibility = dual;
     r.elapsedSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_).count();
+    if (mode == Ipopt::RegularMode && currentIterate(data, quantities)) r.iterate = &iterate_;
+    outcome_.iterations = iteration;
+    r.progress = &outcome_;
     return !onIteration_ || onIteration_(r);
   }
   void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* x, const Number*, const Number*, Index,
@@ -158,6 +165,19 @@ class ProblemTnlp final : public Ipopt::TNLP {
     const Eigen::VectorXi& cols = problem_.jacobianColumns();
     for (Eigen::Index k = 0; k < jacobian_.size(); ++k) out[cols[k]] += jacobian_[k] * lambda[rows[k]];
   }
+  /// Ipopt 3.11 hands the callback its internal iterate only: undo the variable scaling and
+  /// put back the variables it fixed (the TNLP adapter's own mapping) to get our x.
+  bool currentIterate(const Ipopt::IpoptData* data, Ipopt::IpoptCalculatedQuantities* quantities) {
+    if (data == nullptr || quantities == nullptr || !Ipopt::IsValid(data->curr())) return false;
+    auto* original = dynamic_cast<Ipopt::OrigIpoptNLP*>(Ipopt::GetRawPtr(quantities->GetIpoptNLP()));
+    if (original == nullptr) return false;
+    auto* adapter = dynamic_cast<Ipopt::TNLPAdapter*>(Ipopt::GetRawPtr(original->nlp()));
+    if (adapter == nullptr) return false;
+    const Ipopt::SmartPtr<const Ipopt::Vector> x = original->NLP_scaling()->unapply_vector_scaling_x(data->curr()->x());
+    iterate_.resize(start_.size());
+    adapter->ResortX(*x, iterate_.data());
+    return true;
+  }
   static Eigen::VectorXd copy(const Number* x, Index n) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
   template <class F>
   bool guarded(F&& f) {
@@ -177,7 +197,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
   const std::function<bool(const IterationReport&)>& onIteration_;
   std::chrono::steady_clock::time_point clock_;
   bool hessian_;
-  Eigen::VectorXd jacobian_;
+  Eigen::VectorXd jacobian_, iterate_;
 };
 
 void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {

@@ -14,12 +14,18 @@
 
 namespace mcopt {
 
+struct IpoptOutcome;
+
 struct IterationReport {
   int iteration = 0;
   double objective = 0.0;
   double violation = 0.0;      ///< Ipopt's primal infeasibility (of the scaled problem's unscaled rows)
   double dualInfeasibility = 0.0;
   double elapsedSeconds = 0.0;
+  /// The current iterate in the problem's variables; null in Ipopt's restoration phase,
+  /// whose iterates belong to another problem.
+  const Eigen::VectorXd* iterate = nullptr;
+  const IpoptOutcome* progress = nullptr;  ///< evaluations counted so far; no status yet
 };
 
 struct IpoptOutcome {

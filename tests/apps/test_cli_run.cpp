@@ -1,6 +1,6 @@
 // `mcopt run` as a user meets it (issue 7, docs/scenarios.md): Ipopt's derivative checker on
 // the bundled scenario, the result files, torques reproduced by `mcopt dynamics`, an
-// interrupted run, and a message naming file, line and field for every class of bad input.
+// interrupted run, a killed run's checkpoint, and a message naming file, line and field for every class of bad input.
 #include <yaml-cpp/yaml.h>
 
 #include <catch2/catch.hpp>
@@ -140,6 +140,66 @@ TEST_CASE("run: an interrupted run writes its last iterate and exits non-zero", 
   CHECK_THAT(result["reason"].get<std::string>(), Contains("interrupted"));
   CHECK(result["solver"]["iterations"].get<int>() > 0);
   CHECK(result["q"].size() == 100);
+}
+
+TEST_CASE("run: a run killed outright leaves its latest checkpoint, the iterate a shorter run ends at", "[cli][run]") {
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 40;
+    root["solver"]["max_iter"] = 100000;
+    root["hessian"] = "limited-memory";
+  });
+  const auto out = dir.path() / "out";
+  const std::string run = std::string(MCOPT_EXECUTABLE) + " run " + test::quoted(scenario) +
+                          " --configuration-optimisation off --out ";
+  // SIGKILL, which no handler sees, once a checkpoint or two have been written.
+  const std::string command = "( " + run + test::quoted(out) + " --checkpoint-seconds 0 > " +
+                              test::quoted(dir.path() / "log.txt") +
+                              " 2>&1 & pid=$!; for i in $(seq 1 1200); do grep -qs '\"status\": \"running\"' " +
+                              test::quoted(out / "result.json") + " && break; sleep 0.1; done; sleep 1; kill -KILL $pid; "
+                              "wait $pid; echo $? ) 2> /dev/null";  // not the shell's "Killed"
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 256> buffer{};
+  std::string exitCode;
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) exitCode += buffer.data();
+  ::pclose(pipe);
+  CHECK(std::stoi(exitCode) == 128 + 9);
+  const Json killed = readJson(out / "result.json");
+  REQUIRE(killed["status"] == "running");
+  const int iterations = killed["solver"]["iterations"].get<int>();
+  REQUIRE(iterations >= 1);
+  CHECK_THAT(killed["reason"].get<std::string>(), Contains("checkpoint after iteration " + std::to_string(iterations)));
+  CHECK(killed["q"].size() == 40);
+  CHECK(killed["energy"].get<double>() > 0.0);
+
+  // The same run stopped by the iteration limit at that iteration ends where the checkpoint is.
+  const auto limited = dir.path() / "limited";
+  const auto r = test::runMcopt(run.substr(std::string(MCOPT_EXECUTABLE).size() + 1) + test::quoted(limited) +
+                                " --checkpoint-seconds -1 --max-iterations " + std::to_string(iterations));
+  INFO(r.all());
+  REQUIRE(r.exitCode == 4);
+  const Json ended = readJson(limited / "result.json");
+  CHECK(ended["solver"]["iterations"] == iterations);
+  double worst = 0.0, largest = 0.0;
+  std::function<void(const Json&, const Json&)> compare = [&](const Json& a, const Json& b) {
+    if (b.is_number()) {
+      worst = std::max(worst, std::abs(a.get<double>() - b.get<double>()));
+      largest = std::max(largest, std::abs(b.get<double>()));
+      return;
+    }
+    REQUIRE(a.size() == b.size());
+    if (b.is_object())
+      for (const auto& [name, value] : b.items()) compare(a.at(name), value);
+    else
+      for (std::size_t i = 0; i < b.size(); ++i) compare(a[i], b[i]);
+  };
+  compare(killed["parameters"], ended["parameters"]);
+  compare(killed["torques"], ended["torques"]);
+  INFO("worst difference " << worst << " of " << largest);
+  CHECK(largest > 1.0);
+  CHECK(worst <= 1e-9 * largest);
+  CHECK(killed["energy"].get<double>() == Approx(ended["energy"].get<double>()).epsilon(1e-9));
 }
 
 TEST_CASE("run: every class of bad scenario is refused with file, line and field", "[cli][run]") {

@@ -46,6 +46,44 @@ class DiscRosenbrock final : public NlpProblem {
   Eigen::VectorXi rows_ = Eigen::VectorXi::Zero(2), columns_ = (Eigen::VectorXi(2) << 0, 1).finished();
 };
 
+/// The same problem behind a first variable fixed at 0.25 by its bounds, which Ipopt removes
+/// from its own iterate: reported iterates must put it back.
+class FixedThenDiscRosenbrock final : public NlpProblem {
+ public:
+  int variableCount() const override { return 3; }
+  int constraintCount() const override { return 1; }
+  const Eigen::VectorXi& jacobianRows() const override { return rows_; }
+  const Eigen::VectorXi& jacobianColumns() const override { return columns_; }
+  void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override {
+    Eigen::VectorXd l, u;
+    disc_.variableBounds(l, u);
+    lower.resize(3), upper.resize(3);
+    lower << 0.25, l;
+    upper << 0.25, u;
+  }
+  void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override {
+    disc_.constraintBounds(lower, upper);
+  }
+  double objective(const Eigen::VectorXd& v) override {
+    return (v[0] - 1) * (v[0] - 1) + disc_.objective(v.tail<2>());
+  }
+  void objectiveGradient(const Eigen::VectorXd& v, Eigen::VectorXd& g) override {
+    Eigen::VectorXd tail;
+    disc_.objectiveGradient(v.tail<2>(), tail);
+    g.resize(3);
+    g << 2 * (v[0] - 1), tail;
+  }
+  void constraints(const Eigen::VectorXd& v, Eigen::VectorXd& g) override { disc_.constraints(v.tail<2>(), g); }
+  void jacobianValues(const Eigen::VectorXd& v, Eigen::VectorXd& values) override {
+    disc_.jacobianValues(v.tail<2>(), values);
+  }
+  std::string rowName(int) const override { return "disc"; }
+
+ private:
+  DiscRosenbrock disc_;
+  Eigen::VectorXi rows_ = Eigen::VectorXi::Zero(2), columns_ = (Eigen::VectorXi(2) << 1, 2).finished();
+};
+
 }  // namespace
 
 TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", "[outer]") {
@@ -102,6 +140,30 @@ TEST_CASE("Ipopt driver: a stop request ends the solve as interrupted with its i
   CHECK(seen == 3);
   CHECK(o.x.size() == 2);
   CHECK(o.x.allFinite());
+}
+
+TEST_CASE("Ipopt driver: every iteration reports its iterate in the problem's variables", "[outer]") {
+  FixedThenDiscRosenbrock problem;
+  const Eigen::VectorXd start = (Eigen::VectorXd(3) << 0.25, -0.5, 0.2).finished();
+  for (const bool newton : {false, true}) {
+    IpoptSettings settings;
+    settings.finiteDifferenceHessian = newton;
+    int reported = 0;
+    Eigen::VectorXd last;
+    const IpoptOutcome o = solveWithIpopt(problem, start, settings, [&](const IterationReport& r) {
+      if (r.iterate == nullptr) return true;  // restoration phase
+      ++reported;
+      REQUIRE(r.iterate->size() == 3);
+      CHECK((*r.iterate)[0] == 0.25);                                          // the fixed variable put back
+      CHECK(problem.objective(*r.iterate) == Approx(r.objective).epsilon(1e-12));  // it is the reported point
+      last = *r.iterate;
+      return true;
+    });
+    INFO("Hessian by differences: " << newton);
+    CHECK(o.status == "optimal");
+    CHECK(reported == o.iterations + 1);  // iteration 0 included
+    CHECK((last - o.x).norm() <= 1e-14);
+  }
 }
 
 TEST_CASE("Ipopt driver: options Ipopt refuses are input errors naming their origin", "[outer]") {
