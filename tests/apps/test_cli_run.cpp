@@ -38,6 +38,17 @@ std::filesystem::path kickVariant(const test::TempDir& dir, const std::function<
   return dir.write(name, std::string(out.c_str()) + "\n");
 }
 
+/// Runs a shell command that ends by echoing an exit status (of a job it signalled) and returns it.
+int exitStatusEchoed(const std::string& command) {
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 256> buffer{};
+  std::string echoed;
+  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) echoed += buffer.data();
+  ::pclose(pipe);
+  return std::stoi(echoed);
+}
+
 Json readJson(const std::filesystem::path& file) {
   std::ifstream in(file);
   return Json::parse(in);
@@ -128,13 +139,7 @@ TEST_CASE("run: an interrupted run writes its last iterate and exits non-zero", 
   const std::string command = "( " + std::string(MCOPT_EXECUTABLE) + " run " + test::quoted(scenario) + " --out " +
                               test::quoted(out) + " --configuration-optimisation off > " +
                               test::quoted(dir.path() / "log.txt") + " 2>&1 & pid=$!; sleep 5; kill -INT $pid; wait $pid; echo $? )";
-  FILE* pipe = ::popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 256> buffer{};
-  std::string exitCode;
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) exitCode += buffer.data();
-  ::pclose(pipe);
-  CHECK(std::stoi(exitCode) == 130);
+  CHECK(exitStatusEchoed(command) == 130);
   const Json result = readJson(out / "result.json");
   CHECK(result["status"] == "interrupted");
   CHECK_THAT(result["reason"].get<std::string>(), Contains("interrupted"));
@@ -158,13 +163,7 @@ TEST_CASE("run: a run killed outright leaves its latest checkpoint, the iterate 
                               " 2>&1 & pid=$!; for i in $(seq 1 1200); do grep -qs '\"status\": \"running\"' " +
                               test::quoted(out / "result.json") + " && break; sleep 0.1; done; sleep 1; kill -KILL $pid; "
                               "wait $pid; echo $? ) 2> /dev/null";  // not the shell's "Killed"
-  FILE* pipe = ::popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 256> buffer{};
-  std::string exitCode;
-  while (std::fgets(buffer.data(), buffer.size(), pipe) != nullptr) exitCode += buffer.data();
-  ::pclose(pipe);
-  CHECK(std::stoi(exitCode) == 128 + 9);
+  CHECK(exitStatusEchoed(command) == 128 + 9);
   const Json killed = readJson(out / "result.json");
   REQUIRE(killed["status"] == "running");
   const int iterations = killed["solver"]["iterations"].get<int>();
