@@ -79,7 +79,6 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
   checkpoint.solver.message = checkpoint.message;
   checkpoint.solver.iterations = r.iteration;
   checkpoint.solver.objective = r.objective;
-  checkpoint.solver.x = *r.iterate;
   checkpoint.optimisationSeconds = optimisationSeconds;
   checkpoint.totalSeconds = totalSeconds;
   try {

@@ -43,7 +43,7 @@ struct IpoptOutcome {
 struct IpoptSettings {
   std::vector<SolverOption> options;   ///< applied after ours, in order
   int printLevel = 0;                  ///< Ipopt's console output (ours is the progress line)
-  /// Give Ipopt the Lagrangian's Hessian by central differences of the exact gradients
+  /// Give Ipopt the Lagrangian's Hessian by forward differences of the exact gradients
   /// (dense over the nonlinear variables) instead of its limited-memory approximation.
   bool finiteDifferenceHessian = false;
 };
