@@ -89,6 +89,7 @@ class ActiveSetSolver final : public InnerSolver {
   InnerSettings settings_;
   DualActiveSetQp qp_, leastSlack_, shiftedBalance_;
   Eigen::MatrixXd leastSlackHessian_;
+  Eigen::VectorXd leastSlackPoint_;  ///< phase 1's point (InnerResult::leastSlackWrenches)
   std::vector<ConePlanes> planes_;
   Eigen::VectorXd x_, previousX_, coneNu_;
   std::vector<int> workingSet_;
@@ -105,6 +106,7 @@ void ActiveSetSolver::resize(const ContactProblem& p) {
   leastSlack_.resize(n, 0, rows + kSlots * cones);
   shiftedBalance_.resize(n, 0, rows + kSlots * cones + 12);
   leastSlackHessian_.setZero(n, n);
+  leastSlackPoint_.setZero(n);
   planes_.assign(static_cast<std::size_t>(cones), ConePlanes{});
   x_.setZero(n);
   previousX_.setZero(n);
@@ -273,6 +275,7 @@ void ActiveSetSolver::solve(const ContactProblem& p, InnerResult& r) {
       // only touches the admissible set (a face of it), so an equality there is degenerate
       // to roundoff; it is held to a band of ±1e-9 of the data's scale instead, and the slack
       // reported is the returned point's own, W − B F.
+      leastSlackPoint_ = x_;
       const Vector6 target = p.balance * x_;
       const double band = settings_.tolerance * scale;
       const int first = rows_ + kSlots * cones_;
@@ -296,8 +299,10 @@ void ActiveSetSolver::solve(const ContactProblem& p, InnerResult& r) {
   r.kktResidual = kktResidual(p, r);
   const bool converged =
       (outcome == SqpOutcome::Converged || outcome == SqpOutcome::IterationLimit) && r.wrenches.allFinite();
-  if (converged && r.balanceSlack.cwiseAbs().maxCoeff() > 0.0)
+  if (converged && r.balanceSlack.cwiseAbs().maxCoeff() > 0.0) {
     r.status = InnerStatus::Infeasible;
+    r.leastSlackWrenches = leastSlackPoint_;
+  }
   else if (converged && r.kktResidual <= settings_.kktTolerance)
     r.status = InnerStatus::Optimal;
   else

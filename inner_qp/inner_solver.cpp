@@ -221,6 +221,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     leastSlack.tikhonov = 0.0;
     Eigen::VectorXd y = x.allFinite() ? x : Eigen::VectorXd::Zero(n);
     RunOutcome phase1 = run(leastSlack, BalanceMode::Dropped, 0.0, settings, y);
+    r.leastSlackWrenches = y;
     // The least slack is an answer too: certified by its own KKT conditions, or not trusted.
     InnerResult leastSlackResult;
     finishResult(leastSlack, y.data(), leastSlackResult);

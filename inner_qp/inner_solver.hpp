@@ -46,6 +46,11 @@ struct InnerResult {
   double kktResidual = 0.0;             ///< max of stationarity, feasibility, complementarity (see kktResidual)
   double solveTimeUs = 0.0;
   Vector6 balanceSlack = Vector6::Zero();  ///< s of the elastic solution; zero when optimal
+  /// Infeasible: the least-slack phase's own point, the unique minimiser of
+  /// ‖W − B F‖² + ε‖F‖² over the contact constraints. The envelope theorem differentiates
+  /// the least slack's size at this point (phase 2's wrenches are another minimiser of ‖s‖²,
+  /// at which (∂B/∂q) F differs). Meaningful only when Infeasible.
+  Eigen::VectorXd leastSlackWrenches;
   std::string message;                  ///< the underlying solver's own words
 };
 
