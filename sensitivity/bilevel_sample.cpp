@@ -1,0 +1,118 @@
+#include "sensitivity/bilevel_sample.hpp"
+
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurface> contacts,
+                             const MultiContactSettings& settings, const SensitivitySettings& sensitivity, double weight)
+    : contacts_(std::move(contacts)),
+      scale_(1.0 / (weight * weight)),
+      sample_(model, contacts_, settings.problem),
+      solver_(makeInnerSolver(settings.solverName, settings.solver)),
+      sensitivity_(sensitivity) {
+  if (contacts_.empty()) throw InputError("bilevel sample: no contact surface given");
+  const int n = model.jointCount(), nc = contactCount();
+  torque_.setZero(n), g_.setZero(n), linearDv_.setZero(n), linearDa_.setZero(n);
+  for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_}) m->setZero(n, n);
+  dF_.setZero(6 * nc, 3 * n), stationarity_.setZero(6 * nc, 3 * n), balance_.setZero(6, 3 * n);
+  for (auto* m : {&dBFdq_, &dLeastSlackBFdq_, &dWorld_, &dTorqueT_, &dWorldT_}) m->setZero(6, n);
+  for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
+  // Room for the largest active set, so that warm starts copy without allocating.
+  result_.activeSet.reserve(static_cast<std::size_t>(sample_.problem.inequality.rows()) + sample_.problem.cones.size());
+}
+
+BilevelSample::~BilevelSample() = default;
+BilevelSample::BilevelSample(BilevelSample&&) noexcept = default;
+BilevelSample& BilevelSample::operator=(BilevelSample&&) noexcept = default;
+
+void BilevelSample::warmStartFrom(const BilevelSample& other) {
+  if (other.contactCount() != contactCount() || !other.hasResult()) return;
+  result_.wrenches = other.result_.wrenches;
+  result_.activeSet = other.result_.activeSet;
+  result_.inequalityMultipliers = other.result_.inequalityMultipliers;
+  result_.coneMultipliers = other.result_.coneMultipliers;
+}
+
+void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives* d,
+                             const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& v,
+                             const Eigen::Ref<const Eigen::VectorXd>& a, bool withDerivatives) {
+  const int n = model.jointCount(), nc = contactCount();
+  if (withDerivatives && d == nullptr) throw InputError("bilevel sample: derivatives requested without dynamics derivatives");
+  // The inner problem of this sample (formulation.md §5, §7): J1, the contact poses, W0.
+  sample_.update(model, data, actuators, contacts_, v, a);
+  solver_->solve(sample_.problem, result_);
+  const Eigen::MatrixXd& J1 = sample_.wrenchToTorque;
+  torque_ = data.tau;
+  torque_.noalias() -= J1 * result_.wrenches;
+  // φ at the least-slack phase's point: the function whose derivative the envelope theorem gives.
+  const bool infeasible = result_.status == InnerStatus::Infeasible;
+  if (infeasible) leastSlack_.noalias() = data.referenceWrench - sample_.problem.balance * result_.leastSlackWrenches;
+  infeasibility_ = infeasible ? scale_ * leastSlack_.squaredNorm() : 0.0;
+  hasWrenchDerivative_ = false;
+  if (!withDerivatives) return;
+
+  // ∂(J1 F)/∂q and ∂(B F)/∂q at the chosen wrenches.
+  dJ1Fdq_.setZero();
+  dBFdq_.setZero();
+  for (int i = 0; i < nc; ++i) {
+    const Vector6 wrench = result_.wrenches.segment<6>(6 * i);
+    wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
+    dJ1Fdq_ += dTorque_;
+    dBFdq_ += dWorld_;
+  }
+  // φ = ‖s‖²/(m g)², s = W0 − B F: the envelope theorem's derivative (header), at the
+  // least-slack phase's own minimiser.
+  if (result_.status == InnerStatus::Infeasible) {
+    dLeastSlackBFdq_.setZero();
+    for (int i = 0; i < nc; ++i) {
+      const Vector6 wrench = result_.leastSlackWrenches.segment<6>(6 * i);
+      wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
+      dLeastSlackBFdq_ += dWorld_;
+    }
+    dInfeasibilityDq_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * (d->dwrenchDq - dLeastSlackBFdq_);
+    dInfeasibilityDv_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * d->dwrenchDv;
+    dInfeasibilityDa_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * d->dwrenchDa;
+  } else {
+    dInfeasibilityDq_.setZero(), dInfeasibilityDv_.setZero(), dInfeasibilityDa_.setZero();
+  }
+
+  dF_.setZero();
+  if (result_.status == InnerStatus::Optimal) {
+    diagnostics_ = sensitivity_.factorize(sample_.problem, result_);
+    // Right-hand sides at fixed F and multipliers (multi_contact_gradient.hpp).
+    g_.noalias() = 2.0 * sample_.weights.cwiseProduct(torque_);
+    g_ += sample_.linear;
+    innerObjectiveTermDerivatives(actuators, v, linearDv_, linearDa_);
+    for (int i = 0; i < nc; ++i) {
+      transposedWrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], g_,
+                                     result_.balanceMultipliers, dTorqueT_, dWorldT_);
+      stationarity_.block(6 * i, 0, 6, n) = dWorldT_ - dTorqueT_;
+    }
+    const auto& weights = sample_.weights;
+    scaled_.noalias() = 2.0 * weights.asDiagonal() * (d->dtauDq - dJ1Fdq_);
+    stationarity_.leftCols(n).noalias() -= J1.transpose() * scaled_;
+    scaled_.noalias() = 2.0 * weights.asDiagonal() * d->dtauDv;
+    scaled_.diagonal() += linearDv_;
+    stationarity_.middleCols(n, n).noalias() = -J1.transpose() * scaled_;
+    scaled_.noalias() = 2.0 * weights.asDiagonal() * d->dtauDa;
+    scaled_.diagonal() += linearDa_;
+    stationarity_.rightCols(n).noalias() = -J1.transpose() * scaled_;
+    balance_.leftCols(n) = dBFdq_ - d->dwrenchDq;
+    balance_.middleCols(n, n) = -d->dwrenchDv;
+    balance_.rightCols(n) = -d->dwrenchDa;
+    sensitivity_.solve(stationarity_, balance_, dF_);
+    hasWrenchDerivative_ = true;
+  } else {
+    diagnostics_ = SensitivityDiagnostics{};
+  }
+  // dΓ/dx = dΓ0/dx − (∂J1/∂x) F − J1 dF/dx  (4.8)
+  dTorqueDq_ = d->dtauDq - dJ1Fdq_;
+  dTorqueDq_.noalias() -= J1 * dF_.leftCols(n);
+  dTorqueDv_ = d->dtauDv;
+  dTorqueDv_.noalias() -= J1 * dF_.middleCols(n, n);
+  dTorqueDa_ = d->dtauDa;
+  dTorqueDa_.noalias() -= J1 * dF_.rightCols(n);
+}
+
+}  // namespace mcopt
