@@ -29,6 +29,7 @@ extern "C" void requestStop(int) { stopRequested = 1; }
 struct RunOptions {
   std::string scenario, out = "mcopt-run";
   std::string configurationOptimisation;  ///< "", "on" or "off": overrides the scenario
+  std::string contactForces;              ///< "", or a formulation: overrides the scenario
   int maxIterations = -1;
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
 };
@@ -93,6 +94,7 @@ int runMotion(const RunOptions& o) {
   Scenario scenario = loadScenario(o.scenario);
   if (o.configurationOptimisation == "on") scenario.configurationOptimisation = true;
   if (o.configurationOptimisation == "off") scenario.configurationOptimisation = false;
+  if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
   if (o.maxIterations >= 0) {
     SolverOption limit;
     limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
@@ -105,7 +107,12 @@ int runMotion(const RunOptions& o) {
   if (!scenario.description.empty()) std::cout << "  " << scenario.description << "\n";
   std::cout << "  robot " << scenario.robot.name << ": " << scenario.robot.jointCount() << " joints, "
             << std::setprecision(4) << scenario.robot.totalMass() << " kg; reference body " << scenario.referenceBody
-            << ", contact " << scenario.support.name << "\n"
+            << ", contacts " << scenario.support.name;
+  for (const EnvironmentContact& c : scenario.contacts)
+    std::cout << ", " << c.surface.name << (c.window ? " [" + std::to_string(c.start) + ", " + std::to_string(c.end) + "] s" : "");
+  std::cout << (scenario.contacts.empty() ? "" : std::string("; contact forces: ") + toString(scenario.contactForces) +
+                                                     (problem.bilevel() ? " (inner solver " + scenario.inner.solverName + ")" : ""))
+            << "\n"
             << "  " << problem.variableCount() << " variables, " << problem.constraintCount() << " constraints, "
             << problem.jacobianNonZeros() << " Jacobian non-zeros; " << scenario.samples << " samples over "
             << scenario.duration.initial << " s" << (problem.durationIsFree() ? " (duration free)" : "") << "\n";
@@ -128,15 +135,18 @@ int runMotion(const RunOptions& o) {
   std::cout << "motion optimisation (Ipopt, "
             << (scenario.finiteDifferenceHessian ? "Hessian by differences of exact gradients" : "limited-memory Hessian")
             << ")\n"
-            << "   iter      energy [J]   violation   dual inf.     elapsed\n";
+            << "   iter      energy [J]   violation   dual inf.     elapsed" << (problem.bilevel() ? "   infeasible samples" : "")
+            << "\n";
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
   settings.finiteDifferenceHessian = scenario.finiteDifferenceHessian;
   const auto optimisationClock = std::chrono::steady_clock::now();
   double lastCheckpoint = 0.0;
   record.solver = solveWithIpopt(problem, x0, settings, [&](const IterationReport& r) {
-    std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s\n", r.iteration, r.objective, r.violation, r.dualInfeasibility,
+    std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
+    if (problem.bilevel()) std::printf("   %d", problem.infeasibleSamples());
+    std::printf("\n");
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
         r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
@@ -182,6 +192,9 @@ Runner addRun(CLI::App& command) {
   command.add_option("--configuration-optimisation", o->configurationOptimisation,
                      "on or off: override the scenario's initialisation.configuration_optimisation")
       ->check(CLI::IsMember({"on", "off"}));
+  command.add_option("--contact-forces", o->contactForces,
+                     "bilevel, splines or variables: override the scenario's contact_forces (formulation.md §9)")
+      ->check(CLI::IsMember({"bilevel", "splines", "variables"}));
   command.add_option("--max-iterations", o->maxIterations, "override Ipopt's max_iter for the motion");
   command.add_option("--checkpoint-seconds", o->checkpointSeconds,
                      "write the current iterate (status running) at most this often; 0: every iteration, "

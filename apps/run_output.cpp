@@ -5,7 +5,6 @@
 
 #include "apps/json_io.hpp"
 #include "core/atomic_file.hpp"
-#include "core/trajectory_evaluation.hpp"
 
 namespace mcopt::cli {
 
@@ -40,27 +39,10 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   const Eigen::VectorXd parameters = problem.motionParameters(record.x);
   const double T = problem.duration(record.x);
   const int n = robot.jointCount();
-
-  TrajectoryEvaluator regular(problem.model(), scenario.actuators, problem.samples());
-  TrajectoryResult r;
-  regular.evaluate(parameters, T, r);
-  TrajectoryEvaluator fine(problem.model(), scenario.actuators,
-                           SampledTrajectory(problem.parametrization(), scenario.outputSamples));
-  TrajectoryResult f;
-  fine.evaluate(parameters, T, f);
+  const SampledPhysics r = problem.sampledPhysics(record.x);
   const MotionProblem::Violations violations = problem.violations(record.x);
-
   const int N = static_cast<int>(r.time.size());
-  Eigen::MatrixXd contactWrench(N, 6), cop(N, 2);
-  for (int s = 0; s < N; ++s) {
-    const Vector6 w0 = r.referenceWrench.col(s);
-    // referenceWrench is at the reference frame's origin; the support rows take W0 about
-    // the world origin: move it back (m_O = m_ref + p_ref × f).
-    Vector6 atOrigin = w0;
-    atOrigin.tail<3>() += problem.model().referencePose().translation.cross(w0.head<3>());
-    contactWrench.row(s) = problem.support().contactWrench(atOrigin).transpose();
-    cop.row(s) = problem.support().centerOfPressure(atOrigin).transpose();
-  }
+  const bool fine = r.fineTime.size() > 0;
 
   Json result;
   result["status"] = record.status;
@@ -71,7 +53,8 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   result["scenario"] = scenario.file.string();
   result["objective_value"] = record.solver.objective;
   result["energy_form"] = scenario.energyForm == EnergyForm::Epigraph ? "epigraph" : "smooth_max";
-  result["energy_fine"] = f.energy;
+  result["energy_fine"] = numberOrNull(r.fineEnergy);
+  result["contact_forces"] = toString(scenario.contactForces);
   result["joint_names"] = robot.jointNames();
   result["reference_body"] = scenario.referenceBody;
   result["duration"] = T;
@@ -85,12 +68,45 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   result["a"] = matrixToJson(r.a.transpose());
   result["torques"] = matrixToJson(r.tau.transpose());
   result["reference_wrench"] = matrixToJson(r.referenceWrench.transpose());
-  result["contact_wrench"] = {{"contact", scenario.support.name}, {"frame", "contact"}, {"wrench", matrixToJson(contactWrench)}};
-  Json copJson = Json::array();
-  for (int s = 0; s < N; ++s) copJson.push_back({numberOrNull(cop(s, 0)), numberOrNull(cop(s, 1))});
-  result["center_of_pressure"] = copJson;
+  // Per contact: wrench in its frame, centre of pressure, friction-cone margin, closure drift.
+  Json contacts = Json::array();
+  for (std::size_t c = 0; c < r.contactNames.size(); ++c) {
+    Json contact;
+    contact["name"] = r.contactNames[c];
+    contact["reference"] = c == 0;
+    Json active = Json::array(), wrench = Json::array(), copJson = Json::array();
+    for (int s = 0; s < N; ++s) {
+      const bool on = r.active[c][static_cast<std::size_t>(s)];
+      active.push_back(on);
+      wrench.push_back(on ? toJson(r.wrenches[c].col(s)) : Json(nullptr));
+      copJson.push_back(on ? Json::array({numberOrNull(r.centerOfPressure[c](0, s)), numberOrNull(r.centerOfPressure[c](1, s))})
+                           : Json(nullptr));
+    }
+    contact["active"] = active;
+    contact["wrench"] = wrench;
+    contact["center_of_pressure"] = copJson;
+    contact["friction_margin_N"] = toJson(r.frictionMargin[c]);
+    if (c > 0) {
+      const EnvironmentContact& e = scenario.contacts[c - 1];
+      contact["window"] = {e.start, e.end};
+      contact["world_pose"] = {{"position", toJson(e.worldPose.translation)},
+                               {"quaternion_xyzw", toJson(quaternionXyzwFromRotation(e.worldPose.rotation))}};
+      contact["closure_drift_m"] = r.closureDrift[c - 1];
+      contact["closure_drift_rad"] = r.closureRotationDrift[c - 1];
+    }
+    contacts.push_back(contact);
+  }
+  result["contacts"] = contacts;
+  if (!r.innerStatus.empty())
+    result["inner"] = {{"solver", scenario.inner.solverName},
+                       {"status", r.innerStatus},
+                       {"infeasible_samples", r.infeasibleSamples},
+                       {"failed_samples", r.failedSamples}};
   result["power"] = matrixToJson(r.power.transpose());
-  result["power_fine"] = {{"time", toJson(f.time)}, {"power", matrixToJson(f.power.transpose())}};
+  if (fine)
+    result["power_fine"] = {{"time", toJson(r.fineTime)}, {"power", matrixToJson(r.finePower.transpose())}};
+  else
+    result["power_fine"] = nullptr;
   Json byKind = Json::object();
   byKind["position_limit"] = violations.positionLimit;
   for (int k = 0; k < kConstraintKindCount; ++k)
@@ -129,22 +145,28 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   csv << std::setprecision(12) << "time";
   for (const char* kind : {"q", "v", "a", "tau", "power"})
     for (const Joint& joint : robot.joints) csv << "," << kind << ":" << joint.name;
-  for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) csv << ",contact_wrench:" << c;
-  csv << ",cop:x,cop:y\n";
+  for (const std::string& contact : r.contactNames) {
+    for (const char* c : {"fx", "fy", "fz", "mx", "my", "mz"}) csv << "," << contact << ":" << c;
+    csv << "," << contact << ":cop_x," << contact << ":cop_y";
+  }
+  csv << "\n";
   for (int s = 0; s < N; ++s) {
     csv << r.time[s];
     for (const Eigen::MatrixXd* mat : {&r.q, &r.v, &r.a, &r.tau, &r.power})
       for (int j = 0; j < n; ++j) csv << "," << (*mat)(j, s);
-    for (int c = 0; c < 6; ++c) csv << "," << contactWrench(s, c);
-    csv << "," << cop(s, 0) << "," << cop(s, 1) << "\n";
+    for (std::size_t c = 0; c < r.contactNames.size(); ++c) {
+      for (int k = 0; k < 6; ++k) csv << "," << r.wrenches[c](k, s);
+      csv << "," << r.centerOfPressure[c](0, s) << "," << r.centerOfPressure[c](1, s);
+    }
+    csv << "\n";
   }
   std::ostringstream fineCsv;
   fineCsv << std::setprecision(12) << "time";
   for (const Joint& joint : robot.joints) fineCsv << ",power:" << joint.name;
   fineCsv << "\n";
-  for (Eigen::Index s = 0; s < f.time.size(); ++s) {
-    fineCsv << f.time[s];
-    for (int j = 0; j < n; ++j) fineCsv << "," << f.power(j, s);
+  for (Eigen::Index s = 0; s < r.fineTime.size(); ++s) {
+    fineCsv << r.fineTime[s];
+    for (int j = 0; j < n; ++j) fineCsv << "," << r.finePower(j, s);
     fineCsv << "\n";
   }
 

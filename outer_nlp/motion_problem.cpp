@@ -5,9 +5,13 @@
 #include <cmath>
 #include <sstream>
 
+#include "core/contact_maps.hpp"
 #include "core/errors.hpp"
 #include "core/inverse_dynamics.hpp"
+#include "core/kinematics.hpp"
 #include "core/spatial.hpp"
+#include "core/trajectory_evaluation.hpp"
+#include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
@@ -41,6 +45,12 @@ std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInst
   return u;
 }
 
+std::vector<double> sampleTimes(int count) {
+  std::vector<double> u(static_cast<std::size_t>(count));
+  for (int s = 0; s < count; ++s) u[static_cast<std::size_t>(s)] = static_cast<double>(s) / (count - 1);
+  return u;
+}
+
 /// P⁺ ≈ (P + sqrt(P² + ε²)) / 2 and its derivative (formulation.md §6).
 inline double smoothMaximum(double p, double epsilon) { return 0.5 * (p + std::sqrt(p * p + epsilon * epsilon)); }
 inline double smoothMaximumSlope(double p, double epsilon) {
@@ -63,11 +73,34 @@ const char* constraintKindName(ConstraintKind kind) {
     case ConstraintKind::ContactUnilateral: return "contact_unilateral";
     case ConstraintKind::ContactFriction: return "contact_friction";
     case ConstraintKind::ContactCop: return "contact_cop";
+    case ConstraintKind::InnerFeasibility: return "inner_feasibility";
+    case ConstraintKind::Closure: return "closure";
     case ConstraintKind::Task: return "task";
     case ConstraintKind::Epigraph: return "energy_epigraph";
   }
   return "?";
 }
+
+/// Per-thread buffers, sized once (the per-sample path allocates nothing).
+struct MotionProblem::ThreadWorkspace {
+  ThreadWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
+    const int n = model.jointCount();
+    q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
+    torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
+    toTorque.assign(static_cast<std::size_t>(contacts), WrenchToTorque::Zero(n, 6));
+    toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
+    rowsByWrench.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
+  }
+  DynamicsData data;
+  DynamicsDerivatives derivatives;
+  TaskWorkspace task;
+  Eigen::VectorXd q, v, a, torque;
+  Eigen::MatrixXd torqueDq, dTorque;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> referenceDq, dWorld;
+  std::vector<WrenchToTorque> toTorque;  ///< per environment contact, J1_i
+  std::vector<Matrix6> toWorld;          ///< per environment contact, wrenchToWorld_i
+  std::vector<Matrix6> rowsByWrench;     ///< per environment contact, ∂rows_i/∂F_i
+};
 
 MotionProblem::MotionProblem(const Scenario& scenario)
     : scenario_(scenario),
@@ -75,11 +108,37 @@ MotionProblem::MotionProblem(const Scenario& scenario)
       parametrization_(scenario.robot.jointCount(), scenario.controlPoints),
       samples_(parametrization_, scenario.samples),
       taskSamples_(parametrization_, taskInstants(scenario, taskOfInstant_)),
-      support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm()) {
+      support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm()),
+      weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
-  slackStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
+  const int contacts = static_cast<int>(scenario_.contacts.size());
+  outputs_.joints = jointCount_, outputs_.contacts = contacts;
+  forceStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
+  for (const EnvironmentContact& c : scenario_.contacts) {
+    windows_.push_back({c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)});
+    contactRows_.emplace_back(c.surface, RigidTransform{}, weight_);
+  }
+  // With the reference contact alone the wrench is W0 whatever the formulation (§5).
+  bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
+  if (contacts > 0 && !bilevel_)
+    forces_ = std::make_unique<ContactForceParametrization>(scenario_.contactForces, windows_,
+                                                            sampleTimes(scenario_.samples), scenario_.forceControlPoints,
+                                                            forceStart_);
+  slackStart_ = forceStart_ + forceVariableCount();
   variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * scenario_.samples : 0);
+  if (bilevel_) {
+    const std::vector<double> u = sampleTimes(scenario_.samples);
+    for (int s = 0; s < scenario_.samples; ++s) {
+      std::vector<ContactSurface> active{scenario_.support};
+      for (int i = 0; i < contacts; ++i)
+        if (insideWindow(u[static_cast<std::size_t>(s)], windows_[static_cast<std::size_t>(i)]))
+          active.push_back(scenario_.contacts[static_cast<std::size_t>(i)].surface);
+      bilevelSamples_.push_back(
+          std::make_unique<BilevelSample>(model_, active, scenario_.inner, scenario_.sensitivity, weight_));
+    }
+  }
+
   for (int j = 0; j < jointCount_; ++j)
     if (scenario_.torqueLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit))
       torqueJoints_.push_back(j);
@@ -94,38 +153,39 @@ MotionProblem::MotionProblem(const Scenario& scenario)
                                3.0 / (knots[static_cast<std::size_t>(k) + 4] - knots[static_cast<std::size_t>(k) + 1])});
     }
   }
-  contactRowCount_ = scenario_.contactConstraints ? 6 : 0;
 
-  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model_));
-  for (ThreadWorkspace& w : workspaces_) w.q.setZero(jointCount_), w.v.setZero(jointCount_), w.a.setZero(jointCount_);
-  const int outputs = 2 * jointCount_ + 6;
+  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model_, contacts));
+  const int outputs = outputs_.size();
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
-  for (SampleBlock& b : blocks_) {
-    b.y.setZero(outputs), b.dyDT.setZero(outputs);
-    b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
-  }
-  taskBlocks_.resize(taskOfInstant_.size());
-  for (SampleBlock& b : taskBlocks_) {
-    b.y.setZero(3), b.dyDT.setZero(3);
-    b.dyDq.setZero(3, jointCount_), b.dyDv.setZero(3, jointCount_), b.dyDa.setZero(3, jointCount_);
-  }
-  // Local parameters of every sample (the chain rule's column order), fixed for good.
   for (int s = 0; s < samples_.sampleCount(); ++s) {
     SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+    b.y.setZero(outputs), b.dyDT.setZero(outputs), b.wrenches.setZero(6 * (1 + contacts));
+    b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
+    // Local force columns: every term of every contact in contact here, six components each.
+    for (int i = 0; forces_ && i < contacts; ++i)
+      for (const ContactForceParametrization::Term& t : forces_->terms(i, s))
+        for (int c = 0; c < 6; ++c) b.forceColumns.push_back(t.variable + c);
+    b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
+    // Local parameters of every sample (the chain rule's column order), fixed for good.
     samples_.chainRule(s, 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
+  taskBlocks_.resize(taskOfInstant_.size());
   for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
     SampleBlock& b = taskBlocks_[i];
+    b.y.setZero(3), b.dyDT.setZero(3);
+    b.dyDq.setZero(3, jointCount_), b.dyDv.setZero(3, jointCount_), b.dyDa.setZero(3, jointCount_);
     taskSamples_.chainRule(static_cast<int>(i), 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
-  // Sparsity within a sample: Γ_i (and P_i) depends on q_j, q̇_j, q̈_j only when one of the
-  // two joints carries the other (the tree rooted at the reference body); W0 on every joint;
-  // a body's pose and twist on the joints between it and the reference body.
+  // Sparsity within a sample: with forces fixed by the formulation's variables, Γ_i (and
+  // P_i) depends on q_j, q̇_j, q̈_j only when one of the two joints carries the other (the
+  // tree rooted at the reference body; J1's rows follow the same paths); W0 on every joint;
+  // a body's pose and twist on the joints between it and the reference body. The bilevel
+  // wrenches depend on the whole state: then every row depends on every joint.
   relatedJoints_.resize(static_cast<std::size_t>(jointCount_));
   for (int i = 0; i < jointCount_; ++i) {
     allJoints_.push_back(i);
     for (int j = 0; j < jointCount_; ++j)
-      if (model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
+      if (bilevel_ || model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
         relatedJoints_[static_cast<std::size_t>(i)].push_back(j);
   }
   for (const int t : taskOfInstant_) {
@@ -142,54 +202,87 @@ MotionProblem::MotionProblem(const Scenario& scenario)
   buildStructure();
 }
 
+MotionProblem::~MotionProblem() = default;
+
+bool MotionProblem::contactActive(int contact, int sample) const {
+  return insideWindow(static_cast<double>(sample) / (samples_.sampleCount() - 1), windows_[static_cast<std::size_t>(contact)]);
+}
+
+int MotionProblem::infeasibleSamples() const {
+  int count = 0;
+  for (const auto& sample : bilevelSamples_) count += sample->innerResult().status == InnerStatus::Infeasible;
+  return count;
+}
+
 void MotionProblem::buildStructure() {
+  // The one place rows and their Jacobian entries are enumerated.
   std::vector<int> rows, columns;
   const bool freeT = durationIsFree();
-  int row = 0;
-  auto addRow = [&](ConstraintKind kind, int detail, int sample) {
-    rowKind_.push_back(kind), rowDetail_.push_back(detail), rowSample_.push_back(sample);
+  using Source = JacobianEntry::Source;
+  auto entry = [&](int column, JacobianEntry e) {
+    rows.push_back(static_cast<int>(rows_.size()) - 1), columns.push_back(column), entries_.push_back(e);
   };
-  for (const VelocityRow& v : velocityRows_) {
-    addRow(ConstraintKind::VelocityLimit, v.joint, -1);
-    for (const int c : {v.first, v.second}) rows.push_back(row), columns.push_back(c);
-    if (freeT) rows.push_back(row), columns.push_back(parameterCount_);
-    ++row;
+  for (std::size_t v = 0; v < velocityRows_.size(); ++v) {
+    const VelocityRow& velocity = velocityRows_[v];
+    const int block = static_cast<int>(v);
+    rows_.push_back({ConstraintKind::VelocityLimit, velocity.joint, block, -1});
+    entry(velocity.first, {Source::VelocityFirst, false, block, -1, -1, 1.0});
+    entry(velocity.second, {Source::VelocitySecond, false, block, -1, -1, 1.0});
+    if (freeT) entry(parameterCount_, {Source::VelocityDuration, false, block, -1, -1, 1.0});
   }
-  // Only the local parameters of the joints the row depends on (dependsOn lists them).
-  auto sampleColumns = [&](const SampleBlock& b, const std::vector<int>& dependsOn) {
+  // A row reading output `output` of sample (or task instant) `block`: the local parameters
+  // of the joints it depends on, T, and (`withForces`) the sample's force columns.
+  auto sampleRow = [&](ConstraintKind kind, int detail, bool task, int block, int output, double sign,
+                       const std::vector<int>& dependsOn, bool withForces) {
+    rows_.push_back({kind, detail, block, output});
+    const SampleBlock& b = task ? taskBlocks_[static_cast<std::size_t>(block)] : blocks_[static_cast<std::size_t>(block)];
     const int k = static_cast<int>(b.parameters.size()) / jointCount_;
     for (const int j : dependsOn)
-      for (int l = 0; l < k; ++l) rows.push_back(row), columns.push_back(b.parameters[j * k + l]);
-    if (freeT) rows.push_back(row), columns.push_back(parameterCount_);
+      for (int l = 0; l < k; ++l) entry(b.parameters[j * k + l], {Source::Parameter, task, block, output, j * k + l, sign});
+    if (freeT) entry(parameterCount_, {Source::Duration, task, block, output, -1, sign});
+    if (withForces)
+      for (std::size_t c = 0; c < b.forceColumns.size(); ++c)
+        entry(b.forceColumns[c], {Source::Force, task, block, output, static_cast<int>(c), sign});
   };
+  const bool explicitForces = !bilevel_;
+  const int contacts = outputs_.contacts;
   for (int s = 0; s < samples_.sampleCount(); ++s) {
-    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-    for (const int j : torqueJoints_) {
-      addRow(ConstraintKind::TorqueLimit, j, s);
-      sampleColumns(b, relatedJoints_[static_cast<std::size_t>(j)]);
-      ++row;
+    for (const int j : torqueJoints_)
+      sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
+                true);
+    if (scenario_.contactConstraints && explicitForces) {
+      for (int c = 0; c < 6; ++c)
+        sampleRow(c == 0 ? ConstraintKind::ContactUnilateral : c == 1 ? ConstraintKind::ContactFriction : ConstraintKind::ContactCop,
+                  c, false, s, outputs_.referenceRow(c), 1.0, allJoints_, true);
+      // An environment contact's rows read its own wrench, in its own frame: only its variables.
+      const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+      int firstColumn = 0;
+      for (int i = 0; i < contacts; ++i) {
+        const int width = 6 * static_cast<int>(forces_->terms(i, s).size());
+        for (int c = 0; c < 6 && width > 0; ++c) {
+          rows_.push_back({c == 0 ? ConstraintKind::ContactUnilateral : c == 1 ? ConstraintKind::ContactFriction : ConstraintKind::ContactCop,
+                           6 * (i + 1) + c, s, outputs_.contactRow(i, c)});
+          for (int l = firstColumn; l < firstColumn + width; ++l)
+            entry(b.forceColumns[static_cast<std::size_t>(l)], {Source::Force, false, s, outputs_.contactRow(i, c), l, 1.0});
+        }
+        firstColumn += width;
+      }
     }
-    for (int c = 0; c < contactRowCount_; ++c) {
-      addRow(c == 0 ? ConstraintKind::ContactUnilateral : c == 1 ? ConstraintKind::ContactFriction : ConstraintKind::ContactCop,
-             c, s);
-      sampleColumns(b, allJoints_);
-      ++row;
-    }
+    if (bilevel_)
+      sampleRow(ConstraintKind::InnerFeasibility, 0, false, s, outputs_.infeasibility(), 1.0, allJoints_, false);
     if (scenario_.energyForm == EnergyForm::Epigraph)
       for (int j = 0; j < jointCount_; ++j) {
-        addRow(ConstraintKind::Epigraph, j, s);
-        sampleColumns(b, relatedJoints_[static_cast<std::size_t>(j)]);
-        rows.push_back(row), columns.push_back(slackStart_ + s * jointCount_ + j);
-        ++row;
+        sampleRow(ConstraintKind::Epigraph, j, false, s, outputs_.power(j), -1.0, relatedJoints_[static_cast<std::size_t>(j)],
+                  true);
+        entry(slackIndex(s, j), {Source::Slack, false, s, -1, -1, 1.0});
       }
   }
   for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])];
     for (int c = 0; c < 3; ++c) {
       if (!std::isfinite(task.lower[c]) && !std::isfinite(task.upper[c])) continue;
-      addRow(ConstraintKind::Task, c, static_cast<int>(i));
-      sampleColumns(taskBlocks_[i], taskJoints_[i]);
-      ++row;
+      sampleRow(task.closure ? ConstraintKind::Closure : ConstraintKind::Task, c, true, static_cast<int>(i), c, 1.0,
+                taskJoints_[i], false);
     }
   }
   jacobianRows_ = Eigen::Map<Eigen::VectorXi>(rows.data(), static_cast<Eigen::Index>(rows.size()));
@@ -197,31 +290,36 @@ void MotionProblem::buildStructure() {
 }
 
 std::string MotionProblem::rowName(int row) const {
-  const std::size_t r = static_cast<std::size_t>(row);
-  const ConstraintKind kind = rowKind_[r];
-  const int detail = rowDetail_[r], sample = rowSample_[r];
+  const Row& r = rows_[static_cast<std::size_t>(row)];
   std::ostringstream name;
-  switch (kind) {
+  switch (r.kind) {
     case ConstraintKind::VelocityLimit:
-      name << "velocity limit of " << scenario_.robot.joints[static_cast<std::size_t>(detail)].name << " (control points)";
+      name << "velocity limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name << " (control points)";
       return name.str();
     case ConstraintKind::TorqueLimit:
-      name << "torque limit of " << scenario_.robot.joints[static_cast<std::size_t>(detail)].name;
+      name << "torque limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
       break;
     case ConstraintKind::ContactUnilateral:
     case ConstraintKind::ContactFriction:
-    case ConstraintKind::ContactCop: name << scenario_.support.name << " " << SupportContactRows::rowName(detail); break;
-    case ConstraintKind::Epigraph:
-      name << "energy epigraph of " << scenario_.robot.joints[static_cast<std::size_t>(detail)].name;
+    case ConstraintKind::ContactCop: {
+      const int contact = r.detail / 6;
+      name << (contact == 0 ? scenario_.support.name : scenario_.contacts[static_cast<std::size_t>(contact - 1)].surface.name)
+           << " " << SupportContactRows::rowName(r.detail % 6);
       break;
+    }
+    case ConstraintKind::InnerFeasibility: name << "inner problem feasibility (balance slack)"; break;
+    case ConstraintKind::Epigraph:
+      name << "energy epigraph of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
+      break;
+    case ConstraintKind::Closure:
     case ConstraintKind::Task: {
-      const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(sample)])];
-      name << "task '" << task.name << "' component " << "xyz"[detail] << " at u = "
-           << taskSamples_.time(sample, 1.0) << " of the motion";
+      const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(r.block)])];
+      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << "xyz"[r.detail]
+           << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion";
       return name.str();
     }
   }
-  name << " at sample " << sample;
+  name << " at sample " << r.block;
   return name.str();
 }
 
@@ -246,27 +344,27 @@ void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& up
   lower.resize(constraintCount());
   upper.resize(constraintCount());
   for (int r = 0; r < constraintCount(); ++r) {
-    const std::size_t i = static_cast<std::size_t>(r);
-    const int detail = rowDetail_[i];
-    switch (rowKind_[i]) {
+    const Row& row = rows_[static_cast<std::size_t>(r)];
+    switch (row.kind) {
       case ConstraintKind::VelocityLimit: {
-        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(detail)].velocityLimit;
+        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(row.detail)].velocityLimit;
         lower[r] = -limit, upper[r] = limit;
         break;
       }
       case ConstraintKind::TorqueLimit: {
-        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(detail)].torqueLimit;
+        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(row.detail)].torqueLimit;
         lower[r] = -limit, upper[r] = limit;
         break;
       }
       case ConstraintKind::ContactUnilateral: lower[r] = scenario_.minimumNormalForce, upper[r] = kInf; break;
+      case ConstraintKind::InnerFeasibility: lower[r] = -kInf, upper[r] = 0.0; break;
       case ConstraintKind::ContactFriction:
       case ConstraintKind::ContactCop:
       case ConstraintKind::Epigraph: lower[r] = 0.0, upper[r] = kInf; break;
+      case ConstraintKind::Closure:
       case ConstraintKind::Task: {
-        const TaskSpec& task =
-            scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(rowSample_[i])])];
-        lower[r] = task.lower[detail], upper[r] = task.upper[detail];
+        const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(row.block)])];
+        lower[r] = task.lower[row.detail], upper[r] = task.upper[row.detail];
         break;
       }
     }
@@ -277,53 +375,141 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
   Eigen::VectorXd x = Eigen::VectorXd::Zero(variableCount_);
   x.head(parameterCount_) = parametrization_.interpolatedMotion(start, end);
   if (durationIsFree()) x[parameterCount_] = scenario_.duration.initial;
+  if (forces_) {
+    // The inner problem's wrenches along the initial motion: an admissible start, and the
+    // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).
+    const std::vector<double> u = sampleTimes(scenario_.samples);
+    std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, scenario_.samples));
+    ThreadWorkspace& w = workspaces_.front();
+    Eigen::MatrixXd controlPoints;
+    parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
+    std::unique_ptr<BilevelSample> previous;
+    for (int s = 0; s < scenario_.samples; ++s) {
+      std::vector<ContactSurface> active{scenario_.support};
+      std::vector<int> which;
+      for (int i = 0; i < outputs_.contacts; ++i)
+        if (contactActive(i, s)) active.push_back(scenario_.contacts[static_cast<std::size_t>(i)].surface), which.push_back(i);
+      samples_.evaluate(s, controlPoints, duration(x), w.q, w.v, w.a);
+      inverseDynamics(model_, w.data, w.q, w.v, w.a);
+      auto sample = std::make_unique<BilevelSample>(model_, active, scenario_.inner, scenario_.sensitivity, weight_);
+      if (previous) sample->warmStartFrom(*previous);
+      sample->evaluate(model_, w.data, nullptr, scenario_.actuators, w.v, w.a, false);
+      for (std::size_t k = 0; k < which.size(); ++k)
+        wrenches[static_cast<std::size_t>(which[k])].col(s) = sample->innerResult().wrenches.segment<6>(6 * (1 + static_cast<int>(k)));
+      previous = std::move(sample);
+    }
+    forces_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
+  }
   if (scenario_.energyForm == EnergyForm::Epigraph) {
     evaluate(x, false);
     for (int s = 0; s < samples_.sampleCount(); ++s)
       for (int j = 0; j < jointCount_; ++j)
-        x[slackStart_ + s * jointCount_ + j] = std::max(0.0, blocks_[static_cast<std::size_t>(s)].y[jointCount_ + 6 + j]);
+        x[slackIndex(s, j)] = std::max(0.0, blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)]);
   }
   return x;
 }
 
-void MotionProblem::evaluateSample(int s, double T, bool derivatives, ThreadWorkspace& w) {
+void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-  const int n = jointCount_;
+  const int n = jointCount_, contacts = outputs_.contacts;
   samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
   if (derivatives)
     inverseDynamicsDerivatives(model_, w.data, w.derivatives, w.q, w.v, w.a);
   else
     inverseDynamics(model_, w.data, w.q, w.v, w.a);
-  b.y.head(n) = w.data.tau;
+  const DynamicsDerivatives& d = w.derivatives;
   b.acceleration = w.a;
+  b.wrenches.setZero();
 
-  Eigen::Matrix<double, 6, 6> rowsByW0;
-  if (derivatives)
-    support_.evaluate(w.data.referenceWrench, b.y.segment<6>(n), rowsByW0);
-  else
-    support_.evaluate(w.data.referenceWrench, b.y.segment<6>(n));
+  if (bilevel_) {
+    // The inner problem picks the wrenches (formulation.md §7); Γ and its derivatives
+    // through the KKT sensitivity (§8).
+    BilevelSample& sample = *bilevelSamples_[static_cast<std::size_t>(s)];
+    sample.evaluate(model_, w.data, derivatives ? &d : nullptr, scenario_.actuators, w.v, w.a, derivatives);
+    w.torque = sample.torque();
+    b.y[outputs_.infeasibility()] = sample.infeasibility();
+    const Eigen::VectorXd& F = sample.innerResult().wrenches;
+    b.wrenches.head<6>() = F.head<6>();
+    for (int i = 0, k = 1; i < contacts; ++i)
+      if (contactActive(i, s)) b.wrenches.segment<6>(6 * (1 + i)) = F.segment<6>(6 * k++);
+    if (derivatives) {
+      b.dyDq.topRows(n) = sample.torqueDq();
+      b.dyDv.topRows(n) = sample.torqueDv();
+      b.dyDa.topRows(n) = sample.torqueDa();
+      b.dyDq.row(outputs_.infeasibility()) = sample.infeasibilityDq();
+      b.dyDv.row(outputs_.infeasibility()) = sample.infeasibilityDv();
+      b.dyDa.row(outputs_.infeasibility()) = sample.infeasibilityDa();
+    }
+  } else {
+    // Γ = Γ0 − Σ J1_i F_i and W_ref = W0 − Σ wrenchToWorld_i F_i over the environment
+    // contacts in contact here (formulation.md §5, §9); the reference contact takes W_ref.
+    w.torque = w.data.tau;
+    Vector6 reference = w.data.referenceWrench;
+    if (derivatives) w.torqueDq = d.dtauDq, w.referenceDq = d.dwrenchDq;
+    for (int i = 0; i < contacts; ++i) {
+      if (!forces_->active(i, s)) continue;
+      Vector6 F = Vector6::Zero();
+      for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) F += t.weight * x.segment<6>(t.variable);
+      b.wrenches.segment<6>(6 * (1 + i)) = F;
+      const EnvironmentContact& contact = scenario_.contacts[static_cast<std::size_t>(i)];
+      const ContactFrame frame = contactFrame(model_, w.data, contact.surface.frame, contact.surface.placement);
+      WrenchToTorque& toTorque = w.toTorque[static_cast<std::size_t>(i)];
+      Matrix6& toWorld = w.toWorld[static_cast<std::size_t>(i)];
+      wrenchToTorque(model_, w.data, frame, toTorque);
+      wrenchToWorld(frame, toWorld);
+      w.torque.noalias() -= toTorque * F;
+      reference.noalias() -= toWorld * F;
+      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment<6>(outputs_.contactRow(i, 0)),
+                                                        w.rowsByWrench[static_cast<std::size_t>(i)]);
+      if (derivatives) {
+        wrenchMapDerivatives(model_, w.data, frame, F, w.dWorld, w.dTorque);
+        w.torqueDq -= w.dTorque;
+        w.referenceDq -= w.dWorld;
+      }
+    }
+    Eigen::Matrix<double, 6, 6> rowsByReference;
+    if (derivatives)
+      support_.evaluate(reference, b.y.segment<6>(outputs_.referenceRow(0)), rowsByReference);
+    else
+      support_.evaluate(reference, b.y.segment<6>(outputs_.referenceRow(0)));
+    b.wrenches.head<6>() = support_.contactWrench(reference);
+    if (derivatives) {
+      b.dyDq.topRows(n) = w.torqueDq;
+      b.dyDv.topRows(n) = d.dtauDv;
+      b.dyDa.topRows(n) = d.dtauDa;
+      b.dyDq.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * w.referenceDq;
+      b.dyDv.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * d.dwrenchDv;
+      b.dyDa.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * d.dwrenchDa;
+      // Force columns: ∂Γ/∂F_i = −J1_i, ∂rows_ref/∂F_i = −(∂rows/∂W_ref) wrenchToWorld_i,
+      // ∂rows_i/∂F_i, each times the term's weight.
+      int column = 0;
+      for (int i = 0; i < contacts; ++i)
+        for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
+          const auto i_ = static_cast<std::size_t>(i);
+          b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
+          b.dyDz.block(outputs_.referenceRow(0), column, 6, 6).noalias() = -t.weight * rowsByReference * w.toWorld[i_];
+          b.dyDz.block(outputs_.contactRow(i, 0), column, 6, 6) = t.weight * w.rowsByWrench[i_];
+          column += 6;
+        }
+    }
+  }
 
   for (int j = 0; j < n; ++j) {
     const MotorPowerDerivatives p = motorPowerDerivatives(scenario_.actuators.joints[static_cast<std::size_t>(j)],
-                                                          scenario_.actuators.frictionSharpness, w.data.tau[j], w.v[j],
+                                                          scenario_.actuators.frictionSharpness, w.torque[j], w.v[j],
                                                           w.a[j]);
-    b.y[n + 6 + j] = p.power;
+    b.y[outputs_.torque(j)] = w.torque[j];
+    b.y[outputs_.power(j)] = p.power;
     if (!derivatives) continue;
-    const DynamicsDerivatives& d = w.derivatives;
-    b.dyDq.row(n + 6 + j) = p.dTorque * d.dtauDq.row(j);
-    b.dyDv.row(n + 6 + j) = p.dTorque * d.dtauDv.row(j);
-    b.dyDa.row(n + 6 + j) = p.dTorque * d.dtauDa.row(j);
-    b.dyDv(n + 6 + j, j) += p.dVelocity;
-    b.dyDa(n + 6 + j, j) += p.dAcceleration;
+    const int row = outputs_.power(j);
+    b.dyDq.row(row) = p.dTorque * b.dyDq.row(outputs_.torque(j));
+    b.dyDv.row(row) = p.dTorque * b.dyDv.row(outputs_.torque(j));
+    b.dyDa.row(row) = p.dTorque * b.dyDa.row(outputs_.torque(j));
+    b.dyDv(row, j) += p.dVelocity;
+    b.dyDa(row, j) += p.dAcceleration;
+    if (b.dyDz.cols() > 0) b.dyDz.row(row) = p.dTorque * b.dyDz.row(outputs_.torque(j));
   }
   if (!derivatives) return;
-  const DynamicsDerivatives& d = w.derivatives;
-  b.dyDq.topRows(n) = d.dtauDq;
-  b.dyDv.topRows(n) = d.dtauDv;
-  b.dyDa.topRows(n) = d.dtauDa;
-  b.dyDq.middleRows<6>(n).noalias() = rowsByW0 * d.dwrenchDq;
-  b.dyDv.middleRows<6>(n).noalias() = rowsByW0 * d.dwrenchDv;
-  b.dyDa.middleRows<6>(n).noalias() = rowsByW0 * d.dwrenchDa;
   samples_.chainRule(s, T, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
 }
@@ -348,11 +534,20 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   const double T = duration(x);
   parametrization_.controlPoints(x.head(parameterCount_), controlPoints_);
   const int count = samples_.sampleCount(), taskCount = static_cast<int>(taskBlocks_.size());
-#pragma omp parallel
+  const int threads = static_cast<int>(workspaces_.size());
+#pragma omp parallel num_threads(threads)
   {
-    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
-#pragma omp for schedule(static) nowait
-    for (int s = 0; s < count; ++s) evaluateSample(s, T, derivatives, w);
+    // One contiguous block of samples per thread: a bilevel sample without a result of its
+    // own (the first evaluation) is warm-started from its predecessor in the block.
+    const int t = omp_get_thread_num(), used = omp_get_num_threads();
+    const int first = count * t / used, last = count * (t + 1) / used;
+    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(t)];
+    for (int s = first; s < last; ++s) {
+      if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
+        bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
+      evaluateSample(s, x, T, derivatives, w);
+    }
+#pragma omp barrier
 #pragma omp for schedule(static)
     for (int i = 0; i < taskCount; ++i) evaluateTaskInstant(i, T, derivatives, w);
   }
@@ -370,9 +565,10 @@ double MotionProblem::objective(const Eigen::VectorXd& x) {
     const double weight = (s == 0 || s == N - 1) ? 0.5 * dt : dt;
     double sum = 0.0;
     if (scenario_.energyForm == EnergyForm::Epigraph)
-      sum = x.segment(slackStart_ + s * n, n).sum();
+      sum = x.segment(slackIndex(s, 0), n).sum();
     else
-      for (int j = 0; j < n; ++j) sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[n + 6 + j], scenario_.smoothing);
+      for (int j = 0; j < n; ++j)
+        sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)], scenario_.smoothing);
     if (scenario_.accelerationWeight > 0.0)
       sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration.squaredNorm();
     energy += weight * sum;
@@ -404,72 +600,67 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
       dT += scale * (b.acceleration.squaredNorm() / T - 4.0 * b.acceleration.squaredNorm() / T);
     }
     if (epigraph) {
-      gradient.segment(slackStart_ + s * n, n).array() += weight;
-      dT += weight / T * x.segment(slackStart_ + s * n, n).sum();
+      gradient.segment(slackIndex(s, 0), n).array() += weight;
+      dT += weight / T * x.segment(slackIndex(s, 0), n).sum();
       continue;
     }
     for (int j = 0; j < n; ++j) {
-      const double p = b.y[n + 6 + j], slope = weight * smoothMaximumSlope(p, scenario_.smoothing);
-      for (Eigen::Index c = 0; c < b.parameters.size(); ++c) gradient[b.parameters[c]] += slope * b.dyDx(n + 6 + j, c);
-      dT += slope * b.dyDT[n + 6 + j] + weight / T * smoothMaximum(p, scenario_.smoothing);
+      const int row = outputs_.power(j);
+      const double p = b.y[row], slope = weight * smoothMaximumSlope(p, scenario_.smoothing);
+      for (Eigen::Index c = 0; c < b.parameters.size(); ++c) gradient[b.parameters[c]] += slope * b.dyDx(row, c);
+      for (std::size_t c = 0; c < b.forceColumns.size(); ++c)
+        gradient[b.forceColumns[c]] += slope * b.dyDz(row, static_cast<Eigen::Index>(c));
+      dT += slope * b.dyDT[row] + weight / T * smoothMaximum(p, scenario_.smoothing);
     }
   }
   if (durationIsFree()) gradient[parameterCount_] = dT;
 }
 
+double MotionProblem::rowValue(const Row& row, const Eigen::VectorXd& x, double T) const {
+  switch (row.kind) {
+    case ConstraintKind::VelocityLimit: {
+      const VelocityRow& v = velocityRows_[static_cast<std::size_t>(row.block)];
+      return v.scale * (x[v.second] - x[v.first]) / T;
+    }
+    case ConstraintKind::Closure:
+    case ConstraintKind::Task: return taskBlocks_[static_cast<std::size_t>(row.block)].y[row.output];
+    case ConstraintKind::Epigraph:
+      return x[slackIndex(row.block, row.detail)] - blocks_[static_cast<std::size_t>(row.block)].y[row.output];
+    default: return blocks_[static_cast<std::size_t>(row.block)].y[row.output];
+  }
+}
+
 void MotionProblem::constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) {
   evaluate(x, false);
   const double T = duration(x);
-  const int n = jointCount_;
   values.resize(constraintCount());
-  int row = 0;
-  for (const VelocityRow& v : velocityRows_) values[row++] = v.scale * (x[v.second] - x[v.first]) / T;
-  for (int s = 0; s < samples_.sampleCount(); ++s) {
-    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-    for (const int j : torqueJoints_) values[row++] = b.y[j];
-    for (int c = 0; c < contactRowCount_; ++c) values[row++] = b.y[n + c];
-    if (scenario_.energyForm == EnergyForm::Epigraph)
-      for (int j = 0; j < n; ++j) values[row++] = x[slackStart_ + s * n + j] - b.y[n + 6 + j];
-  }
-  for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
-    const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])];
-    for (int c = 0; c < 3; ++c)
-      if (std::isfinite(task.lower[c]) || std::isfinite(task.upper[c])) values[row++] = taskBlocks_[i].y[c];
-  }
+  for (int r = 0; r < constraintCount(); ++r) values[r] = rowValue(rows_[static_cast<std::size_t>(r)], x, T);
 }
 
 void MotionProblem::jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& values) {
   evaluate(x, true);
   const double T = duration(x);
-  const bool freeT = durationIsFree();
-  const int n = jointCount_;
   values.resize(jacobianNonZeros());
-  Eigen::Index k = 0;
-  for (const VelocityRow& v : velocityRows_) {
-    values[k++] = -v.scale / T;
-    values[k++] = v.scale / T;
-    if (freeT) values[k++] = -v.scale * (x[v.second] - x[v.first]) / (T * T);
-  }
-  auto sampleRow = [&](const SampleBlock& b, int output, double sign, const std::vector<int>& dependsOn) {
-    const int local = static_cast<int>(b.parameters.size()) / n;
-    for (const int j : dependsOn)
-      for (int l = 0; l < local; ++l) values[k++] = sign * b.dyDx(output, j * local + l);
-    if (freeT) values[k++] = sign * b.dyDT[output];
-  };
-  for (int s = 0; s < samples_.sampleCount(); ++s) {
-    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-    for (const int j : torqueJoints_) sampleRow(b, j, 1.0, relatedJoints_[static_cast<std::size_t>(j)]);
-    for (int c = 0; c < contactRowCount_; ++c) sampleRow(b, n + c, 1.0, allJoints_);
-    if (scenario_.energyForm == EnergyForm::Epigraph)
-      for (int j = 0; j < n; ++j) {
-        sampleRow(b, n + 6 + j, -1.0, relatedJoints_[static_cast<std::size_t>(j)]);
-        values[k++] = 1.0;
+  using Source = JacobianEntry::Source;
+  for (std::size_t k = 0; k < entries_.size(); ++k) {
+    const JacobianEntry& e = entries_[k];
+    const auto block = static_cast<std::size_t>(e.block);
+    const SampleBlock* b = e.block < 0 ? nullptr : e.task ? &taskBlocks_[block] : &blocks_[block];
+    double value = 0.0;
+    switch (e.source) {
+      case Source::Parameter: value = b->dyDx(e.output, e.local); break;
+      case Source::Duration: value = b->dyDT[e.output]; break;
+      case Source::Force: value = b->dyDz(e.output, e.local); break;
+      case Source::Slack: value = 1.0; break;
+      case Source::VelocityFirst: value = -velocityRows_[block].scale / T; break;
+      case Source::VelocitySecond: value = velocityRows_[block].scale / T; break;
+      case Source::VelocityDuration: {
+        const VelocityRow& v = velocityRows_[block];
+        value = -v.scale * (x[v.second] - x[v.first]) / (T * T);
+        break;
       }
-  }
-  for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
-    const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])];
-    for (int c = 0; c < 3; ++c)
-      if (std::isfinite(task.lower[c]) || std::isfinite(task.upper[c])) sampleRow(taskBlocks_[i], c, 1.0, taskJoints_[i]);
+    }
+    values[static_cast<Eigen::Index>(k)] = e.sign * value;
   }
 }
 
@@ -489,6 +680,76 @@ MotionProblem::Violations MotionProblem::violations(const Eigen::VectorXd& x) {
     if (violation > v.overall) v.overall = violation, v.worstRow = r;
   }
   return v;
+}
+
+SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
+  evaluate(x, false);
+  const int N = samples_.sampleCount(), n = jointCount_, contacts = outputs_.contacts;
+  const double T = duration(x);
+  SampledPhysics p;
+  p.time.resize(N);
+  for (Eigen::MatrixXd* m : {&p.q, &p.v, &p.a, &p.tau, &p.tau0, &p.power}) m->resize(n, N);
+  p.referenceWrench.resize(6, N);
+  p.contactNames.push_back(scenario_.support.name);
+  for (const EnvironmentContact& c : scenario_.contacts) p.contactNames.push_back(c.surface.name);
+  std::vector<const ContactSurface*> surfaces{&scenario_.support};
+  for (const EnvironmentContact& c : scenario_.contacts) surfaces.push_back(&c.surface);
+  p.wrenches.assign(surfaces.size(), Eigen::MatrixXd::Zero(6, N));
+  p.active.assign(surfaces.size(), std::vector<bool>(static_cast<std::size_t>(N), true));
+  p.centerOfPressure.assign(surfaces.size(), Eigen::MatrixXd::Constant(2, N, std::numeric_limits<double>::quiet_NaN()));
+  p.frictionMargin.assign(surfaces.size(), Eigen::VectorXd::Zero(N));
+  ThreadWorkspace& w = workspaces_.front();
+  for (int s = 0; s < N; ++s) {
+    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+    p.time[s] = samples_.time(s, T);
+    samples_.evaluate(s, controlPoints_, T, p.q.col(s), p.v.col(s), p.a.col(s));
+    inverseDynamics(model_, w.data, p.q.col(s), p.v.col(s), p.a.col(s));
+    p.tau0.col(s) = w.data.tau;
+    p.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
+    for (int j = 0; j < n; ++j) p.tau(j, s) = b.y[outputs_.torque(j)], p.power(j, s) = b.y[outputs_.power(j)];
+    for (std::size_t c = 0; c < surfaces.size(); ++c) {
+      const bool active = c == 0 || contactActive(static_cast<int>(c) - 1, s);
+      p.active[c][static_cast<std::size_t>(s)] = active;
+      if (!active) continue;
+      const Vector6 F = b.wrenches.segment<6>(6 * static_cast<Eigen::Index>(c));
+      p.wrenches[c].col(s) = F;
+      if (F[2] > 0.0) p.centerOfPressure[c].col(s) = Eigen::Vector2d(-F[4] / F[2], F[3] / F[2]);
+      p.frictionMargin[c][s] = surfaces[c]->friction * F[2] - F.head<2>().norm();
+    }
+    if (bilevel_) {
+      const InnerStatus status = bilevelSamples_[static_cast<std::size_t>(s)]->innerResult().status;
+      p.innerStatus.push_back(toString(status));
+      p.infeasibleSamples += status == InnerStatus::Infeasible;
+      p.failedSamples += status == InnerStatus::Failed;
+    }
+  }
+  p.energy = positiveEnergy(p.power, p.time);
+  if (contacts == 0) {
+    TrajectoryEvaluator evaluator(model_, scenario_.actuators, SampledTrajectory(parametrization_, scenario_.outputSamples));
+    TrajectoryResult fineResult;
+    evaluator.evaluate(x.head(parameterCount_), T, fineResult);
+    p.fineTime = fineResult.time, p.finePower = fineResult.power, p.fineEnergy = fineResult.energy;
+  }
+  // Closure drift between the samples: the contact frames at the scenario's output samples.
+  const SampledTrajectory fine(parametrization_, scenario_.outputSamples);
+  p.closureDrift.assign(static_cast<std::size_t>(contacts), 0.0);
+  p.closureRotationDrift.assign(static_cast<std::size_t>(contacts), 0.0);
+  for (int s = 0; s < fine.sampleCount(); ++s) {
+    const double u = static_cast<double>(s) / (fine.sampleCount() - 1);
+    fine.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+    forwardKinematics(model_, w.data, w.q);
+    for (int i = 0; i < contacts; ++i) {
+      if (!insideWindow(u, windows_[static_cast<std::size_t>(i)])) continue;
+      const EnvironmentContact& c = scenario_.contacts[static_cast<std::size_t>(i)];
+      const RigidTransform pose = framePose(model_, w.data, c.surface.frame) * c.surface.placement;
+      const double distance = (pose.translation - c.worldPose.translation).norm();
+      const Eigen::AngleAxisd error(Matrix3(c.worldPose.rotation.transpose() * pose.rotation));
+      p.closureDrift[static_cast<std::size_t>(i)] = std::max(p.closureDrift[static_cast<std::size_t>(i)], distance);
+      p.closureRotationDrift[static_cast<std::size_t>(i)] =
+          std::max(p.closureRotationDrift[static_cast<std::size_t>(i)], std::abs(error.angle()));
+    }
+  }
+  return p;
 }
 
 }  // namespace mcopt

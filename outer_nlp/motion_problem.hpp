@@ -3,30 +3,49 @@
 // of Ipopt so that tests can probe it: variables, bounds, objective, constraints, their
 // exact gradient and sparse Jacobian.
 //
-// Variables x = [free spline parameters (joint-major), T when free, epigraph slacks s_js].
-// Constraint rows, in this order:
+// Variables x = [free spline parameters (joint-major), T when free, contact-force variables z
+// (splines / variables formulations), epigraph slacks s_js].
+//
+// Contacts (formulation.md §5, §9): the reference body's surface carries the robot at every
+// instant; every other contact (scenario `contacts`) is fixed in the world over its window.
+// Its wrench comes from the scenario's contact-force formulation:
+//   bilevel    an inner problem per sample over the contacts active there picks them
+//              (sensitivity/bilevel_sample.hpp); exact gradients through its KKT system;
+//   splines / variables   they are linear in z (contact_force_parametrization.hpp) and the
+//              reference contact's wrench follows from the balance,
+//              W_ref = W0 − Σ_i wrenchToWorld_i F_i, so the balance holds exactly.
+// With the reference contact alone, the three are the one-contact problem: W_ref = W0.
+//
+// Constraint rows, each described once in the row registry (kind, sample or task instant,
+// which output of that sample's evaluation) from which bounds, values, the Jacobian's
+// pattern and its values are all read:
 //   1. velocity limits on the velocity control points 3 (p_{k+1} − p_k) / (T Δu) (§3:
 //      they bound the whole continuous motion); position limits are variable bounds,
 //      since every control point is a free parameter;
-//   2. per sample s: torque limits Γ0_js ∈ [−L_j, L_j]; the reference sole's wrench W0 in
-//      its contact frame: f_z ≥ f_min, (μ² f_z² − f_x² − f_y²)/(m g)² ≥ 0, centre of
-//      pressure in the rectangle written linearly (x_min f_z ≤ −m_y ≤ x_max f_z,
-//      y_min f_z ≤ m_x ≤ y_max f_z); with the epigraph form s_js − P_js ≥ 0;
-//   3. task rows: per task, per instant, per bounded component.
-// Sample rows depend only on the ≤ 4 local parameters of every joint (+ T, + a slack),
-// which is the declared sparsity (B-spline local support).
+//   2. per sample s: torque limits Γ_js ∈ [−L_j, L_j] with Γ = Γ0 − Σ J1_i F_i; per contact
+//      in contact there (splines, variables; the reference one always): f_z ≥ f_min,
+//      (μ² f_z² − f_x² − f_y²)/(m g)² ≥ 0, the centre of pressure in the rectangle written
+//      linearly; bilevel: the inner problem's infeasibility φ = ‖slack‖²/(m g)² ≤ 0 (the
+//      inner problem holds the contacts' own rows); with the epigraph form s_js − P_js ≥ 0;
+//   3. task rows: per task, per instant, per bounded component; a contact's closure (its
+//      frame at its world pose over its window) is a pair of such tasks.
+// Sample rows depend only on the ≤ 4 local parameters of the joints that move them (+ T,
+// + the sample's force variables, + a slack), which is the declared sparsity.
 //
 // Objective: E = Σ_s c_s Δt Σ_j P⁺_js, Δt = T/(N − 1), trapezoid weights c_s, with P⁺
 // the smooth maximum (P + sqrt(P² + ε²))/2 or the epigraph slack (formulation.md §6), plus
 // the scenario's regularisation w Σ_s c_s Δt Σ_j q̈_js² (formulation.md §10; 0 by default).
 
 #include <Eigen/Core>
+#include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/bspline.hpp"
 #include "core/dynamics_derivatives.hpp"
 #include "core/dynamics_model.hpp"
+#include "outer_nlp/contact_force_parametrization.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/support_contact.hpp"
@@ -34,13 +53,44 @@
 
 namespace mcopt {
 
-enum class ConstraintKind { VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, Task, Epigraph };
-inline constexpr int kConstraintKindCount = 7;
+enum class ConstraintKind {
+  VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, InnerFeasibility, Closure, Task, Epigraph
+};
+inline constexpr int kConstraintKindCount = 9;
 const char* constraintKindName(ConstraintKind kind);
+
+class BilevelSample;
+
+/// Everything a motion's samples say, for results (apps serialise it; nothing is re-evaluated there).
+struct SampledPhysics {
+  Eigen::VectorXd time;                        ///< N [s]
+  Eigen::MatrixXd q, v, a, tau, tau0, power;   ///< n × N; tau = Γ with the contact wrenches, tau0 = Γ0
+  Eigen::MatrixXd referenceWrench;             ///< 6 × N, W0 at the reference frame origin, world axes
+  /// Per contact (the reference one first, then the scenario's order): 6 × N wrenches in the
+  /// contact frame, zero where the contact is not active; whether it is active; centre of
+  /// pressure (NaN without load); friction-cone margin μ f_z − ‖f_t‖ [N].
+  std::vector<std::string> contactNames;
+  std::vector<Eigen::MatrixXd> wrenches;
+  std::vector<std::vector<bool>> active;
+  std::vector<Eigen::MatrixXd> centerOfPressure;  ///< 2 × N each
+  std::vector<Eigen::VectorXd> frictionMargin;
+  std::vector<double> closureDrift;             ///< per contact: worst distance [m] of its frame from its pose (output samples)
+  std::vector<double> closureRotationDrift;     ///< per contact: worst angle [rad]
+  std::vector<std::string> innerStatus;         ///< bilevel: per sample
+  int infeasibleSamples = 0, failedSamples = 0;
+  double energy = 0.0;                          ///< ∫ Σ max(P, 0) dt at the samples (trapezoid)
+  /// The scenario's output samples: power per joint and energy. With the reference contact
+  /// alone (Γ = Γ0 there); with more contacts the wrenches exist at the samples only, and
+  /// these stay empty.
+  Eigen::VectorXd fineTime;
+  Eigen::MatrixXd finePower;
+  double fineEnergy = std::numeric_limits<double>::quiet_NaN();
+};
 
 class MotionProblem final : public NlpProblem {
  public:
   explicit MotionProblem(const Scenario& scenario);
+  ~MotionProblem() override;
   const SupportContactRows& support() const { return support_; }
 
   const Scenario& scenario() const { return scenario_; }
@@ -48,22 +98,31 @@ class MotionProblem final : public NlpProblem {
   const MotionParametrization& parametrization() const { return parametrization_; }
   const SampledTrajectory& samples() const { return samples_; }
   bool durationIsFree() const { return scenario_.duration.free(); }
+  /// The formulation in use: with the reference contact alone there are no contact forces to choose.
+  bool bilevel() const { return bilevel_; }
+  int forceVariableCount() const { return forces_ ? forces_->variableCount() : 0; }
+  int forceVariableStart() const { return forceStart_; }
+  /// Bilevel: samples whose inner problem was infeasible at the last evaluation.
+  int infeasibleSamples() const;
+  /// Whether environment contact i (scenario.contacts order) is in contact at sample s.
+  bool contactActive(int contact, int sample) const;
 
   int variableCount() const override { return variableCount_; }
   int nonlinearVariableCount() const override { return slackStart_; }
-  int constraintCount() const override { return static_cast<int>(rowKind_.size()); }
+  int constraintCount() const override { return static_cast<int>(rows_.size()); }
   int jacobianNonZeros() const { return static_cast<int>(jacobianRows_.size()); }
   const Eigen::VectorXi& jacobianRows() const override { return jacobianRows_; }
   const Eigen::VectorXi& jacobianColumns() const override { return jacobianColumns_; }
-  ConstraintKind rowKind(int row) const { return rowKind_[static_cast<std::size_t>(row)]; }
-  /// e.g. "torque limit LLEG_JOINT3 at t = 0.512 s".
+  ConstraintKind rowKind(int row) const { return rows_[static_cast<std::size_t>(row)].kind; }
+  /// e.g. "torque limit LLEG_JOINT3 at sample 12".
   std::string rowName(int row) const override;
 
   void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
   void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
 
   /// The motion from `start` to `end` (inner control points spaced linearly), the initial
-  /// duration, and epigraph slacks at max(P, 0) of that motion.
+  /// duration, force variables fitted to the inner problem's wrenches along that motion
+  /// (splines, variables), and epigraph slacks at max(P, 0) of that motion.
   Eigen::VectorXd initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end);
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
   double duration(const Eigen::VectorXd& x) const {
@@ -84,26 +143,53 @@ class MotionProblem final : public NlpProblem {
   };
   Violations violations(const Eigen::VectorXd& x);
 
+  /// The motion's physics at the samples (and closure drift at the scenario's output samples).
+  SampledPhysics sampledPhysics(const Eigen::VectorXd& x);
+
+  /// Output index of each per-sample quantity (rows of a sample's evaluation).
+  struct SampleOutputs {
+    int joints = 0, contacts = 0;  ///< n, environment contacts
+    int torque(int j) const { return j; }
+    int referenceRow(int c) const { return joints + c; }
+    int contactRow(int contact, int c) const { return joints + 6 + 6 * contact + c; }
+    int infeasibility() const { return joints + 6 + 6 * contacts; }
+    int power(int j) const { return joints + 7 + 6 * contacts + j; }
+    int size() const { return 2 * joints + 7 + 6 * contacts; }
+  };
+
  private:
   struct SampleBlock {
-    Eigen::VectorXd y;        ///< [Γ0 (n), contact rows (6), power (n)]
+    Eigen::VectorXd y;             ///< outputs, SampleOutputs order
     Eigen::VectorXd acceleration;  ///< q̈ (n), for the regularisation
-    Eigen::MatrixXd dyDx;     ///< rows × local parameters
+    Eigen::VectorXd wrenches;      ///< 6 (1 + contacts): each contact's wrench in its frame (zero when inactive)
+    Eigen::MatrixXd dyDx;          ///< rows × local parameters
     Eigen::VectorXd dyDT;
     Eigen::VectorXi parameters;
     Eigen::MatrixXd dyDq, dyDv, dyDa;
+    Eigen::MatrixXd dyDz;          ///< rows × local force columns
+    std::vector<int> forceColumns; ///< global variable of each local force column
   };
-  struct ThreadWorkspace {
-    explicit ThreadWorkspace(const DynamicsModel& model) : data(model), derivatives(model), task(model) {}
-    DynamicsData data;
-    DynamicsDerivatives derivatives;
-    TaskWorkspace task;
-    Eigen::VectorXd q, v, a;
+  struct ThreadWorkspace;
+  /// A row of the registry: its kind, what `detail` says (joint, contact row, task
+  /// component), the sample / task instant / velocity row it belongs to, and the output it reads.
+  struct Row {
+    ConstraintKind kind;
+    int detail, block, output;
+  };
+  /// Where a Jacobian entry's value comes from.
+  struct JacobianEntry {
+    enum class Source : unsigned char { Parameter, Duration, Force, Slack, VelocityFirst, VelocitySecond, VelocityDuration };
+    Source source;
+    bool task;  ///< a task block rather than a sample block
+    int block, output, local;
+    double sign;
   };
   void evaluate(const Eigen::VectorXd& x, bool derivatives);
-  void evaluateSample(int s, double duration, bool derivatives, ThreadWorkspace& w);
+  void evaluateSample(int s, const Eigen::VectorXd& x, double duration, bool derivatives, ThreadWorkspace& w);
   void evaluateTaskInstant(int i, double duration, bool derivatives, ThreadWorkspace& w);
   void buildStructure();
+  double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
+  int slackIndex(int sample, int joint) const { return slackStart_ + sample * jointCount_ + joint; }
 
   const Scenario& scenario_;
   DynamicsModel model_;
@@ -111,7 +197,13 @@ class MotionProblem final : public NlpProblem {
   SampledTrajectory samples_;
   std::vector<int> taskOfInstant_;        ///< task index of each task instant
   SampledTrajectory taskSamples_;         ///< the task instants, as normalised times
-  int jointCount_ = 0, parameterCount_ = 0, variableCount_ = 0, slackStart_ = 0;
+  int jointCount_ = 0, parameterCount_ = 0, variableCount_ = 0, slackStart_ = 0, forceStart_ = 0;
+  SampleOutputs outputs_;
+  bool bilevel_ = false;
+  std::vector<std::array<double, 2>> windows_;   ///< per environment contact, normalised
+  std::unique_ptr<ContactForceParametrization> forces_;
+  std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
+  std::vector<SupportContactRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants
@@ -119,12 +211,11 @@ class MotionProblem final : public NlpProblem {
   struct VelocityRow { int joint, first, second; double scale; };  ///< 3 (x_second − x_first)/(T Δu) → scale = 3/Δu
   std::vector<VelocityRow> velocityRows_;
   SupportContactRows support_;
+  double weight_ = 0.0;                   ///< m g [N]
 
-  std::vector<ConstraintKind> rowKind_;
-  std::vector<int> rowDetail_;            ///< joint, task component or contact row index
-  std::vector<int> rowSample_;            ///< sample or task instant (−1 for velocity rows)
+  std::vector<Row> rows_;
+  std::vector<JacobianEntry> entries_;
   Eigen::VectorXi jacobianRows_, jacobianColumns_;
-  int contactRowCount_ = 0;
 
   std::vector<SampleBlock> blocks_, taskBlocks_;
   std::vector<ThreadWorkspace> workspaces_;

@@ -1,9 +1,12 @@
 #include "outer_nlp/scenario.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <map>
 
 #include "core/errors.hpp"
+#include "core/inverse_dynamics.hpp"
+#include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/yaml_fields.hpp"
 
@@ -169,7 +172,159 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
   }
 }
 
+
+/// The world pose of a contact frame in a posture (the reference body at its scenario pose).
+RigidTransform contactPoseAt(const Scenario& s, const ContactSurface& surface, const Eigen::VectorXd& posture) {
+  const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
+  DynamicsData data(model);
+  forwardKinematics(model, data, posture);
+  return framePose(model, data, surface.frame) * surface.placement;
+}
+
+/// The closure of a contact as two tasks over its window (formulation.md §10): the contact
+/// frame's origin at its world position, the body's orientation at the one that puts the
+/// contact frame at its world orientation.
+void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
+  TaskSpec position;
+  position.name = "closure of " + c.surface.name + " (position)";
+  position.origin = c.origin;
+  position.closure = true;
+  position.kind = TaskKind::Position;
+  position.body = s.robot.frames[static_cast<std::size_t>(c.surface.frame)].name;
+  position.frame = c.surface.frame;
+  position.point = c.surface.placement.translation;
+  position.start = c.start, position.end = c.end, position.window = c.end > c.start;
+  position.lower = c.worldPose.translation.array() - s.closurePositionTolerance;
+  position.upper = c.worldPose.translation.array() + s.closurePositionTolerance;
+  TaskSpec orientation = position;
+  orientation.name = "closure of " + c.surface.name + " (orientation)";
+  orientation.kind = TaskKind::Orientation;
+  orientation.point = Vector3::Zero();
+  orientation.targetRotation = c.worldPose.rotation * c.surface.placement.rotation.transpose();
+  orientation.lower.setConstant(-s.closureOrientationTolerance);
+  orientation.upper.setConstant(s.closureOrientationTolerance);
+  s.tasks.push_back(position);
+  s.tasks.push_back(orientation);
+}
+
+void readContacts(const std::filesystem::path& file, const YAML::Node& list, const std::vector<ContactSurface>& surfaces,
+                  Scenario& s) {
+  const int referenceBody = s.robot.frames[static_cast<std::size_t>(s.robot.frameIndex(s.referenceBody))].body;
+  bool haveReference = false;
+  std::vector<std::string> seen;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const YAML::Node entry = list[i];
+    const std::string field = "contacts[" + std::to_string(i) + "]";
+    // (A YAML::Node handle is never re-assigned: assignment writes through to the node it refers to.)
+    if (entry.IsMap()) yaml::rejectUnknownKeys(file, entry, field, {"surface", "window", "pose"});
+    const YAML::Node nameNode = entry.IsMap() ? yaml::required(file, entry, "surface", field) : entry;
+    const std::string name = yaml::text(file, nameNode, entry.IsMap() ? field + ".surface" : field);
+    const auto surface = std::find_if(surfaces.begin(), surfaces.end(), [&](const ContactSurface& c) { return c.name == name; });
+    if (surface == surfaces.end())
+      throw InputError(where(file, nameNode, field) + "unknown contact surface '" + name + "'");
+    if (std::find(seen.begin(), seen.end(), name) != seen.end())
+      throw InputError(where(file, nameNode, field) + "contact '" + name + "' is listed twice");
+    seen.push_back(name);
+    const bool onReference = s.robot.frames[static_cast<std::size_t>(surface->frame)].body == referenceBody;
+    if (onReference) {
+      if (haveReference)
+        throw InputError(where(file, nameNode, field) + "a second contact on the reference body '" + s.referenceBody + "'");
+      if (entry.IsMap() && (entry["window"] || entry["pose"]))
+        throw InputError(where(file, entry["window"] ? entry["window"] : entry["pose"], field) + "contact '" + name +
+                         "' is on the reference body, which is fixed in the world for the whole motion: it takes no "
+                         "window and no pose (reference_pose places it)");
+      s.support = *surface;
+      haveReference = true;
+      continue;
+    }
+    EnvironmentContact c;
+    c.surface = *surface;
+    c.origin = where(file, entry, field);
+    c.origin.resize(c.origin.size() - 2);
+    c.end = s.duration.initial;
+    if (entry.IsMap() && entry["window"]) {
+      const YAML::Node w = entry["window"];
+      const auto t = yaml::numbers(file, w, field + ".window", 2);
+      const double T = s.duration.initial;
+      if (!(t[0] >= 0.0 && t[0] < t[1] && t[1] <= T * (1 + 1e-12)))
+        throw InputError(where(file, w, field + ".window") + "expected [start, end] with 0 ≤ start < end ≤ " +
+                         std::to_string(T) + " s (the motion)");
+      int inside = 0;
+      for (int k = 0; k < s.samples; ++k) {
+        const double tk = T * k / (s.samples - 1);
+        inside += tk >= t[0] - 1e-9 * T && tk <= t[1] + 1e-9 * T;
+      }
+      if (inside == 0)
+        throw InputError(where(file, w, field + ".window") + "holds no sample of the motion (" + std::to_string(s.samples) +
+                         " samples over " + std::to_string(T) + " s)");
+      c.start = t[0], c.end = t[1], c.window = true;
+    }
+    if (entry.IsMap() && entry["pose"]) {
+      const YAML::Node pose = entry["pose"];
+      yaml::rejectUnknownKeys(file, pose, field + ".pose", {"position", "rpy"});
+      const auto p = yaml::numbers(file, yaml::required(file, pose, "position", field + ".pose"), field + ".pose.position", 3);
+      const auto r = yaml::numbers(file, yaml::required(file, pose, "rpy", field + ".pose"), field + ".pose.rpy", 3);
+      c.worldPose.translation = Vector3(p[0], p[1], p[2]);
+      c.worldPose.rotation = rotationFromRpy(r[0], r[1], r[2]);
+      c.poseGiven = true;
+    } else {
+      c.worldPose = contactPoseAt(s, c.surface, s.start);
+    }
+    s.contacts.push_back(c);
+  }
+  if (!haveReference)
+    throw InputError(where(file, list, "contacts") + "no contact on the reference body '" + s.referenceBody +
+                     "' (the reference body's surface must be one of the contacts)");
+  for (const EnvironmentContact& c : s.contacts) addClosureTasks(c, s);
+}
+
+void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
+  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance"});
+  if (node["solver"]) {
+    const std::string name = yaml::text(file, node["solver"], "inner.solver");
+    if (name != "active-set" && name != "slsqp" && name != "ipopt")
+      throw InputError(where(file, node["solver"], "inner.solver") + "unknown inner solver '" + name +
+                       "' (expected active-set, slsqp or ipopt)");
+    s.inner.solverName = name;
+  }
+  if (node["contact_model"]) {
+    const std::string name = yaml::text(file, node["contact_model"], "inner.contact_model");
+    static const std::map<std::string, ContactModel> models = {
+        {"report", ContactModel::Report}, {"pyramid", ContactModel::Pyramid}, {"wrench-cone", ContactModel::WrenchCone}};
+    const auto m = models.find(name);
+    if (m == models.end())
+      throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" + name +
+                       "' (expected report, pyramid or wrench-cone)");
+    s.inner.problem.model = m->second;
+  }
+  if (node["pyramid_facets"])
+    s.inner.problem.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
+  if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
+  if (node["kkt_backend"]) {
+    try {
+      s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));
+    } catch (const InputError& e) {
+      throw InputError(where(file, node["kkt_backend"], "inner.kkt_backend") + e.what());
+    }
+  }
+}
 }  // namespace
+
+const char* toString(ContactForces forces) {
+  switch (forces) {
+    case ContactForces::Bilevel: return "bilevel";
+    case ContactForces::Splines: return "splines";
+    case ContactForces::Variables: return "variables";
+  }
+  return "bilevel";
+}
+
+ContactForces parseContactForces(const std::string& name) {
+  if (name == "bilevel") return ContactForces::Bilevel;
+  if (name == "splines") return ContactForces::Splines;
+  if (name == "variables") return ContactForces::Variables;
+  throw InputError("unknown contact-force formulation '" + name + "' (expected bilevel, splines or variables)");
+}
 
 Scenario loadScenario(const std::filesystem::path& file) {
   const YAML::Node root = yaml::loadFile(file);
@@ -178,7 +333,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "solver"});
+                           "initialisation", "hessian", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance"});
   Scenario s;
   s.file = file;
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
@@ -210,23 +365,11 @@ Scenario loadScenario(const std::filesystem::path& file) {
     s.gravity = Vector3(g[0], g[1], g[2]);
   }
 
-  // Contacts: the reference body's surface; more contacts need the bilevel outer problem.
+  // Contacts: the reference body's surface and any others; read once the duration and the
+  // start posture are known (windows and default poses depend on them).
   const YAML::Node contactsNode = yaml::required(file, root, "contacts", "");
   if (!contactsNode.IsSequence() || contactsNode.size() == 0)
-    throw InputError(where(file, contactsNode, "contacts") + "expected a list of contact surface names");
-  if (contactsNode.size() > 1)
-    throw InputError(where(file, contactsNode[1], "contacts[1]") +
-                     "mcopt run optimises motions on one contact, the reference body's; a second contact makes "
-                     "the problem bilevel (formulation.md §7), which the outer problem does not support");
-  const std::string contactName = yaml::text(file, contactsNode[0], "contacts[0]");
-  bool found = false;
-  for (const ContactSurface& c : surfaces)
-    if (c.name == contactName) s.support = c, found = true;
-  if (!found) throw InputError(where(file, contactsNode[0], "contacts[0]") + "unknown contact surface '" + contactName + "'");
-  if (s.robot.frames[static_cast<std::size_t>(s.support.frame)].body !=
-      s.robot.frames[static_cast<std::size_t>(s.robot.frameIndex(s.referenceBody))].body)
-    throw InputError(where(file, contactsNode[0], "contacts[0]") + "contact '" + contactName +
-                     "' is not on the reference body '" + s.referenceBody + "'");
+    throw InputError(where(file, contactsNode, "contacts") + "expected a list of contact surface names or entries");
 
   const YAML::Node durationNode = yaml::required(file, root, "duration", "");
   if (durationNode.IsMap()) {
@@ -292,6 +435,25 @@ Scenario loadScenario(const std::filesystem::path& file) {
                            std::to_string(q) + " rad is outside its limits [" + std::to_string(limit.lower) + ", " +
                            std::to_string(limit.upper) + "]");
     }
+  if (root["closure_tolerance"]) {
+    const YAML::Node node = root["closure_tolerance"];
+    yaml::rejectUnknownKeys(file, node, "closure_tolerance", {"position", "orientation"});
+    if (node["position"]) s.closurePositionTolerance = yaml::nonNegative(file, node["position"], "closure_tolerance.position");
+    if (node["orientation"])
+      s.closureOrientationTolerance = yaml::nonNegative(file, node["orientation"], "closure_tolerance.orientation");
+  }
+  readContacts(file, contactsNode, surfaces, s);
+  if (root["contact_forces"]) {
+    const YAML::Node node = root["contact_forces"];
+    try {
+      s.contactForces = parseContactForces(yaml::text(file, node, "contact_forces"));
+    } catch (const InputError& e) {
+      throw InputError(where(file, node, "contact_forces") + e.what());
+    }
+  }
+  if (root["force_control_points"])
+    s.forceControlPoints = integerField(file, root["force_control_points"], "force_control_points", 4);
+  if (root["inner"]) readInnerSettings(file, root["inner"], s);
   if (root["initialisation"]) {
     const YAML::Node init = root["initialisation"];
     yaml::rejectUnknownKeys(file, init, "initialisation", {"configuration_optimisation", "configuration_iterations"});

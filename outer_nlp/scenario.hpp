@@ -13,6 +13,8 @@
 #include "core/actuators.hpp"
 #include "core/robot_files.hpp"
 #include "core/robot_model.hpp"
+#include "inner_qp/multi_contact_dynamics.hpp"
+#include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt {
 
@@ -28,6 +30,7 @@ struct TaskSpec {
   std::string name;          ///< from the file, or "tasks[i]"
   std::string origin;        ///< "file:line" of the task, for messages
   TaskKind kind = TaskKind::Position;
+  bool closure = false;      ///< made by a contact: its frame holds its world pose (formulation.md §10)
   std::string body;          ///< URDF link (empty for the centre of mass)
   int frame = -1;            ///< RobotModel frame of `body`
   Vector3 point = Vector3::Zero();       ///< in the body frame (position, linear velocity)
@@ -36,6 +39,28 @@ struct TaskSpec {
   bool window = false;
   Eigen::Vector3d lower = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   Eigen::Vector3d upper = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+};
+
+/// How the contact wrenches enter the outer problem (formulation.md §9).
+enum class ContactForces {
+  Bilevel,    ///< an inner problem per sample picks them; exact gradients through its KKT system
+  Splines,    ///< each wrench component of a non-reference contact is a B-spline of NLP variables
+  Variables,  ///< each wrench of a non-reference contact at each sample is an NLP variable
+};
+const char* toString(ContactForces forces);
+/// "bilevel", "splines" or "variables"; throws InputError otherwise (the message lists them).
+ContactForces parseContactForces(const std::string& name);
+
+/// A contact other than the reference body's: its surface is fixed in the world over the
+/// whole motion or over a window, at a given world pose or the one it has in the start
+/// posture (formulation.md §10).
+struct EnvironmentContact {
+  ContactSurface surface;
+  std::string origin;          ///< "file:line" of the entry, for messages
+  double start = 0.0, end = 0.0;  ///< window [s] of the initial duration; the whole motion unless given
+  bool window = false;
+  bool poseGiven = false;
+  RigidTransform worldPose;    ///< of the contact frame
 };
 
 struct DurationSpec {
@@ -60,7 +85,17 @@ struct Scenario {
   std::string referenceBody;
   RigidTransform referencePose;
   Vector3 gravity{0.0, 0.0, -9.81};
-  ContactSurface support;          ///< the reference body's contact surface (the only contact for now)
+  ContactSurface support;          ///< the reference body's contact surface
+  std::vector<EnvironmentContact> contacts;  ///< the other contacts, in the file's order
+  /// Closure of the environment contacts as a box on the pose error at the samples: a spline
+  /// motion stays on the closed chain's (non-polynomial) manifold only up to such a band
+  /// (docs/scenarios.md, "Multi-contact").
+  double closurePositionTolerance = 1e-3;     ///< [m]
+  double closureOrientationTolerance = 1e-3;  ///< [rad], on sin θ of the error rotation
+  ContactForces contactForces = ContactForces::Bilevel;
+  int forceControlPoints = 9;      ///< per wrench spline (splines formulation), over its contact's window
+  MultiContactSettings inner;      ///< bilevel: contact model and inner solver
+  SensitivitySettings sensitivity; ///< bilevel: KKT backend
   bool contactConstraints = true;  ///< unilaterality, friction cone and CoP of W0 at the samples
   double minimumNormalForce = 0.0; ///< f_z ≥ this [N]
 

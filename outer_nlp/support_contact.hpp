@@ -17,7 +17,8 @@ namespace mcopt {
 
 class SupportContactRows {
  public:
-  /// contactPose: world pose of C; weight: m g [N].
+  /// contactPose: world pose of C; weight: m g [N]. With the identity pose the wrench given to
+  /// evaluate() is taken as already in C (a contact whose wrench is a variable of its own).
   SupportContactRows(const ContactSurface& surface, const RigidTransform& contactPose, double weight);
 
   /// W0: world axes, about the world origin. rows: the six values (unilaterality without f_min).

@@ -100,11 +100,13 @@ TEST_CASE("run: result files, their fields, and torques that mcopt dynamics repr
   CHECK(result["energy"].get<double>() > 0.0);
   CHECK(result["max_violation"].get<double>() >= 0.0);
   CHECK_THAT(result["reason"].get<std::string>(), Contains("Maximum Number of Iterations"));
-  for (const char* key : {"parameters", "time", "q", "v", "a", "torques", "contact_wrench", "center_of_pressure",
-                          "power", "power_fine", "violation_by_kind", "solver", "timings", "configuration_optimisation"})
+  for (const char* key : {"parameters", "time", "q", "v", "a", "torques", "contacts", "power", "power_fine", "violation_by_kind", "solver", "timings", "configuration_optimisation"})
     CHECK(result.contains(key));
   CHECK(result["q"].size() == static_cast<std::size_t>(samples));
   CHECK(result["power_fine"]["power"].size() == 500);
+  REQUIRE(result["contacts"].size() == 1);
+  CHECK(result["contacts"][0]["name"] == "l_sole");
+  CHECK(result["contacts"][0]["wrench"].size() == static_cast<std::size_t>(samples));
   CHECK(result["solver"]["iterations"] == 15);
   CHECK(result["configuration_optimisation"]["start"]["optimised"] == true);
   for (const char* file : {"trajectory.csv", "power_fine.csv", "states.json"}) CHECK(std::filesystem::exists(out / file));
@@ -231,9 +233,25 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"posture outside the limits", [](YAML::Node& r) { r["start"]["offsets"]["RLEG_JOINT3"] = 5.0; },
        {"start: joint RLEG_JOINT3", "outside its limits"}},
       {"unknown contact", [](YAML::Node& r) { r["contacts"][0] = "l_knee"; }, {"contacts[0]: unknown contact surface 'l_knee'"}},
-      {"contact off the reference body", [](YAML::Node& r) { r["contacts"][0] = "r_sole"; },
-       {"contacts[0]: contact 'r_sole' is not on the reference body"}},
-      {"several contacts", [](YAML::Node& r) { r["contacts"].push_back("r_hand"); }, {"contacts[1]: mcopt run optimises motions on one contact"}},
+      {"no contact on the reference body", [](YAML::Node& r) { r["contacts"][0] = "r_sole"; },
+       {"contacts: no contact on the reference body 'l_sole'"}},
+      {"duplicated contact", [](YAML::Node& r) { r["contacts"].push_back("r_hand"), r["contacts"].push_back("r_hand"); },
+       {"contacts[2]: contact 'r_hand' is listed twice"}},
+      {"window outside the motion", [](YAML::Node& r) {
+         r["contacts"].push_back(YAML::Load("{surface: r_hand, window: [1.0, 2.0]}"));
+       }, {"contacts[1].window: expected [start, end] with 0 ≤ start < end ≤ 1.6"}},
+      {"empty window", [](YAML::Node& r) {
+         r["contacts"].push_back(YAML::Load("{surface: r_hand, window: [0.801, 0.802]}"));
+       }, {"contacts[1].window: holds no sample of the motion"}},
+      {"window on the reference contact", [](YAML::Node& r) {
+         r["contacts"][0] = YAML::Load("{surface: l_sole, window: [0.2, 0.4]}");
+       }, {"contacts[0]: contact 'l_sole' is on the reference body", "takes no window"}},
+      {"unknown formulation", [](YAML::Node& r) { r["contact_forces"] = "penalty"; },
+       {"contact_forces: unknown contact-force formulation 'penalty' (expected bilevel, splines or variables)"}},
+      {"unknown contact model", [](YAML::Node& r) { r["inner"]["contact_model"] = "cone"; },
+       {"inner.contact_model: unknown contact model 'cone'"}},
+      {"unknown inner solver", [](YAML::Node& r) { r["inner"]["solver"] = "qpoases"; },
+       {"inner.solver: unknown inner solver 'qpoases'"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},

@@ -10,6 +10,7 @@
 #include "core/spatial.hpp"
 
 #include "common/finite_differences.hpp"
+#include "common/nlp_jacobian.hpp"
 #include "common/test_support.hpp"
 #include "outer_nlp/configuration_problem.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -18,28 +19,13 @@ namespace mcopt {
 
 namespace {
 
-Eigen::MatrixXd denseJacobian(NlpProblem& problem, const Eigen::VectorXd& x) {
-  Eigen::VectorXd values;
-  problem.jacobianValues(x, values);
-  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(problem.constraintCount(), problem.variableCount());
-  for (Eigen::Index k = 0; k < values.size(); ++k) dense(problem.jacobianRows()[k], problem.jacobianColumns()[k]) += values[k];
-  return dense;
-}
-
-Eigen::MatrixXd declaredPattern(NlpProblem& problem) {
-  Eigen::MatrixXd pattern = Eigen::MatrixXd::Zero(problem.constraintCount(), problem.variableCount());
-  for (Eigen::Index k = 0; k < problem.jacobianRows().size(); ++k)
-    pattern(problem.jacobianRows()[k], problem.jacobianColumns()[k]) = 1.0;
-  return pattern;
-}
-
 /// Largest |exact − differences| / (1 + |differences|) and whether every entry off the
 /// declared pattern is zero in the differences.
 void checkDerivatives(NlpProblem& problem, Eigen::VectorXd x, double h, double tolerance) {
   Eigen::VectorXd gradient;
   problem.objectiveGradient(x, gradient);
-  const Eigen::MatrixXd jacobian = denseJacobian(problem, x);
-  const Eigen::MatrixXd pattern = declaredPattern(problem);
+  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
+  const Eigen::MatrixXd pattern = test::declaredPattern(problem);
   const Eigen::MatrixXd fd = test::centralDifferences(x, h, [&] {
     Eigen::VectorXd out(1 + problem.constraintCount());
     out[0] = problem.objective(x);
