@@ -1,10 +1,15 @@
 // `mcopt dynamics`: inverse dynamics of given states with the reference body held
-// fixed (formulation.md §4). Formats: docs/file-formats.md.
+// fixed (formulation.md §4), and with --contacts the torques that given contact wrenches
+// leave to the motors (§5). Formats: docs/file-formats.md.
+#include <algorithm>
 #include <iostream>
+#include <optional>
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
 #include "core/atomic_file.hpp"
+#include "core/contact_maps.hpp"
+#include "core/robot_files.hpp"
 #include "core/dynamics_derivatives.hpp"
 
 namespace mcopt::cli {
@@ -12,7 +17,7 @@ namespace mcopt::cli {
 namespace {
 
 struct DynamicsOptions {
-  std::string robot, referenceBody, states, out;
+  std::string robot, referenceBody, states, out, contacts;
   bool allowNonPhysicalInertia = false;
   bool derivatives = false;
 };
@@ -30,6 +35,57 @@ RigidTransform readPose(const std::filesystem::path& file, const json_io::Json& 
     pose.rotation = rotationFromQuaternionXyzw(q[0], q[1], q[2], q[3]);
   }
   return pose;
+}
+
+/// Contact wrenches per state (docs/file-formats.md, "Contact wrenches"): each listed surface
+/// with its wrench in its own frame at every state, or null where it is not in contact.
+struct StateContacts {
+  std::vector<ContactSurface> surfaces;
+  std::vector<std::vector<std::optional<Vector6>>> wrenches;  ///< [contact][state]
+};
+
+StateContacts readContacts(const std::filesystem::path& file, const RobotModel& robot, std::size_t stateCount) {
+  const json_io::Json input = json_io::readFile(file);
+  if (!input.is_object()) throw InputError(file.string() + ": expected a JSON object");
+  for (const auto& [key, value] : input.items())
+    if (key != "contact_surfaces" && key != "contacts")
+      throw InputError(file.string() + ": " + key + ": unknown key (expected contact_surfaces, contacts)");
+  if (!input.contains("contact_surfaces") || !input["contact_surfaces"].is_string())
+    throw InputError(file.string() + ": contact_surfaces: expected the path of a contact surface file");
+  // Relative to the contacts file, never to the working directory.
+  const std::filesystem::path surfacesFile = file.parent_path() / input["contact_surfaces"].get<std::string>();
+  const std::vector<ContactSurface> surfaces = loadContactSurfaces(surfacesFile, robot);
+  if (!input.contains("contacts") || !input["contacts"].is_array())
+    throw InputError(file.string() + ": contacts: expected a list of {surface, wrenches}");
+  StateContacts out;
+  for (std::size_t i = 0; i < input["contacts"].size(); ++i) {
+    const auto& entry = input["contacts"][i];
+    const std::string field = "contacts[" + std::to_string(i) + "]";
+    if (!entry.is_object() || !entry.contains("surface") || !entry["surface"].is_string() || !entry.contains("wrenches"))
+      throw InputError(file.string() + ": " + field + ": expected {surface: NAME, wrenches: [...]}");
+    const std::string name = entry["surface"];
+    const auto surface =
+        std::find_if(surfaces.begin(), surfaces.end(), [&](const ContactSurface& c) { return c.name == name; });
+    if (surface == surfaces.end())
+      throw InputError(file.string() + ": " + field + ".surface: unknown contact surface '" + name + "' (in " +
+                       surfacesFile.string() + ")");
+    const auto& list = entry["wrenches"];
+    if (!list.is_array() || list.size() != stateCount)
+      throw InputError(file.string() + ": " + field + ".wrenches: expected one wrench (or null) per state, " +
+                       std::to_string(stateCount) + " in all");
+    out.surfaces.push_back(*surface);
+    out.wrenches.emplace_back();
+    for (std::size_t s = 0; s < list.size(); ++s) {
+      if (list[s].is_null()) {
+        out.wrenches.back().push_back(std::nullopt);
+        continue;
+      }
+      const Eigen::VectorXd w =
+          json_io::numbers(file, list[s], field + ".wrenches[" + std::to_string(s) + "]", 6);
+      out.wrenches.back().push_back(Vector6(w));
+    }
+  }
+  return out;
 }
 
 int runDynamics(const DynamicsOptions& o) {
@@ -91,6 +147,12 @@ int runDynamics(const DynamicsOptions& o) {
   if (!input.contains("states") || !input["states"].is_array())
     throw InputError(file.string() + ": states: expected a list of {q, v, a}");
   const long count = static_cast<long>(columns.size());
+  const StateContacts contacts =
+      o.contacts.empty() ? StateContacts{} : readContacts(o.contacts, robot, input["states"].size());
+  if (!contacts.surfaces.empty() && o.derivatives)
+    throw InputError("--derivatives and --contacts: the derivatives are those of Γ0 and W0 only; give one or the other");
+  WrenchToTorque toTorque = WrenchToTorque::Zero(robot.jointCount(), 6);
+  Eigen::VectorXd withContacts(robot.jointCount());
   json_io::Json results = json_io::Json::array();
   Eigen::VectorXd q(robot.jointCount()), v(robot.jointCount()), a(robot.jointCount()), tau(count);
   for (std::size_t s = 0; s < input["states"].size(); ++s) {
@@ -113,6 +175,20 @@ int runDynamics(const DynamicsOptions& o) {
     for (long k = 0; k < count; ++k) tau[k] = data.tau[columns[static_cast<std::size_t>(k)]];
     json_io::Json result = {{"tau", json_io::toJson(tau)},
                             {"reference_wrench", json_io::toJson(referenceWrenchAtReferenceFrame(model, data))}};
+    if (!contacts.surfaces.empty()) {
+      // Γ = Γ0 − Σ_i J1_i F_i (formulation.md §5) over the contacts given at this state.
+      withContacts = data.tau;
+      for (std::size_t i = 0; i < contacts.surfaces.size(); ++i) {
+        const std::optional<Vector6>& wrench = contacts.wrenches[i][s];
+        if (!wrench) continue;
+        const ContactSurface& c = contacts.surfaces[i];
+        wrenchToTorque(model, data, contactFrame(model, data, c.frame, c.placement), toTorque);
+        withContacts.noalias() -= toTorque * *wrench;
+      }
+      result["tau0"] = result["tau"];
+      for (long k = 0; k < count; ++k) tau[k] = withContacts[columns[static_cast<std::size_t>(k)]];
+      result["tau"] = json_io::toJson(tau);
+    }
     if (o.derivatives) {
       result["dtau_dq"] = selectTau(derivatives.dtauDq);
       result["dtau_dv"] = selectTau(derivatives.dtauDv);
@@ -143,6 +219,9 @@ Runner addDynamics(CLI::App& command) {
                      "link held fixed at reference_pose (default: the URDF root); any link, sole frames included");
   command.add_option("--states", o->states, "input JSON (docs/file-formats.md)")->required();
   command.add_option("--out", o->out, "output JSON (default: standard output)");
+  command.add_option("--contacts", o->contacts,
+                     "contact wrenches per state (JSON, docs/file-formats.md): tau becomes Γ = Γ0 − J1 F, tau0 is Γ0")
+      ->check(CLI::ExistingFile);
   command.add_flag("--derivatives", o->derivatives,
                    "add dtau_dq, dtau_dv, dtau_da, dwrench_dq, dwrench_dv, dwrench_da (exact, analytic)");
   command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,

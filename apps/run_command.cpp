@@ -108,8 +108,10 @@ int runMotion(const RunOptions& o) {
   std::cout << "  robot " << scenario.robot.name << ": " << scenario.robot.jointCount() << " joints, "
             << std::setprecision(4) << scenario.robot.totalMass() << " kg; reference body " << scenario.referenceBody
             << ", contacts " << scenario.support.name;
-  for (const EnvironmentContact& c : scenario.contacts)
-    std::cout << ", " << c.surface.name << (c.window ? " [" + std::to_string(c.start) + ", " + std::to_string(c.end) + "] s" : "");
+  for (const EnvironmentContact& c : scenario.contacts) {
+    std::cout << ", " << c.surface.name;
+    if (c.window) std::cout << " [" << c.start << ", " << c.end << "] s";
+  }
   std::cout << (scenario.contacts.empty() ? "" : std::string("; contact forces: ") + toString(scenario.contactForces) +
                                                      (problem.bilevel() ? " (inner solver " + scenario.inner.solverName + ")" : ""))
             << "\n"
@@ -176,7 +178,7 @@ int runMotion(const RunOptions& o) {
             << "  iterations         " << record.solver.iterations << "\n"
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
-            << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json\n";
+            << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";
   if (!record.reason.empty() && !record.solver.optimal) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
   if (record.status == "interrupted") return kExitInterrupted;
   return record.solver.optimal ? 0 : kExitNotOptimal;

@@ -141,6 +141,18 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   for (int s = 0; s < N; ++s)
     states["states"].push_back({{"q", toJson(r.q.col(s))}, {"v", toJson(r.v.col(s))}, {"a", toJson(r.a.col(s))}});
 
+  // The contact wrenches as a `mcopt dynamics --contacts` input: with states.json it
+  // reproduces `torques` (Γ = Γ0 − J1 F).
+  Json wrenchFile;
+  wrenchFile["contact_surfaces"] = std::filesystem::absolute(scenario.contactSurfacesFile).lexically_normal().string();
+  wrenchFile["contacts"] = Json::array();
+  for (std::size_t c = 0; c < r.contactNames.size(); ++c) {
+    Json list = Json::array();
+    for (int s = 0; s < N; ++s)
+      list.push_back(r.active[c][static_cast<std::size_t>(s)] ? toJson(r.wrenches[c].col(s)) : Json(nullptr));
+    wrenchFile["contacts"].push_back({{"surface", r.contactNames[c]}, {"wrenches", list}});
+  }
+
   std::ostringstream csv;
   csv << std::setprecision(12) << "time";
   for (const char* kind : {"q", "v", "a", "tau", "power"})
@@ -174,6 +186,7 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   writeFileAtomically(directory / "trajectory.csv", csv.str());
   writeFileAtomically(directory / "power_fine.csv", fineCsv.str());
   writeFileAtomically(directory / "states.json", states.dump(1) + "\n");
+  writeFileAtomically(directory / "contact_wrenches.json", wrenchFile.dump(1) + "\n");
   // result.json last: once it names this run, the other files are this run's too.
   writeFileAtomically(directory / "result.json", result.dump(1) + "\n");
   return {r.energy, violations.overall};

@@ -339,7 +339,8 @@ Scenario loadScenario(const std::filesystem::path& file) {
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
   s.robot = loadUrdfFile(sideFile(file, root, "robot"));
   s.actuators = loadActuators(sideFile(file, root, "actuators"), s.robot);
-  const auto surfaces = loadContactSurfaces(sideFile(file, root, "contact_surfaces"), s.robot);
+  s.contactSurfacesFile = sideFile(file, root, "contact_surfaces");
+  const auto surfaces = loadContactSurfaces(s.contactSurfacesFile, s.robot);
   const auto postures = loadPostures(sideFile(file, root, "postures"), s.robot);
   if (root["friction_sharpness"])
     s.actuators.frictionSharpness = yaml::positive(file, root["friction_sharpness"], "friction_sharpness");

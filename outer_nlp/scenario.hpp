@@ -79,6 +79,7 @@ struct SolverOption {
 
 struct Scenario {
   std::filesystem::path file;
+  std::filesystem::path contactSurfacesFile;  ///< the side file the contacts were read from
   std::string description;
   RobotModel robot;
   ActuatorSet actuators;

@@ -26,16 +26,21 @@ constexpr bool kUnderSanitizers = true;
 constexpr bool kUnderSanitizers = false;
 #endif
 
-/// The bundled kick with its side files made absolute, then `edit` applied, written to dir.
-std::filesystem::path kickVariant(const test::TempDir& dir, const std::function<void(YAML::Node&)>& edit,
-                                  const std::string& name = "scenario.yaml") {
-  YAML::Node root = YAML::LoadFile(kKick.string());
+/// A bundled scenario with its side files made absolute, then `edit` applied, written to dir.
+std::filesystem::path scenarioVariant(const std::filesystem::path& source, const test::TempDir& dir,
+                                      const std::function<void(YAML::Node&)>& edit, const std::string& name) {
+  YAML::Node root = YAML::LoadFile(source.string());
   for (const char* key : {"robot", "actuators", "contact_surfaces", "postures"})
-    root[key] = (kKick.parent_path() / root[key].as<std::string>()).lexically_normal().string();
+    root[key] = (source.parent_path() / root[key].as<std::string>()).lexically_normal().string();
   edit(root);
   YAML::Emitter out;
   out << root;
   return dir.write(name, std::string(out.c_str()) + "\n");
+}
+
+std::filesystem::path kickVariant(const test::TempDir& dir, const std::function<void(YAML::Node&)>& edit,
+                                  const std::string& name = "scenario.yaml") {
+  return scenarioVariant(kKick, dir, edit, name);
 }
 
 /// Runs a shell command that ends by echoing an exit status (of a job it signalled) and returns it.
@@ -279,4 +284,61 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
   const auto r = test::runMcopt("run " + test::quoted(malformed));
   CHECK(r.exitCode == 2);
   CHECK_THAT(r.errors, Contains(malformed.string() + ":") && Contains("malformed YAML"));
+}
+
+TEST_CASE("run: multi-contact results, torques reproduced from states and contact wrenches", "[cli][run][multi-contact]") {
+  // Each formulation on the two-sole weight shift, a few iterations: result.json's torques
+  // are Γ0 − J1 F of its own states and wrenches, as `mcopt dynamics --contacts` computes them.
+  const test::TempDir dir;
+  for (const char* forces : {"bilevel", "splines", "variables"}) {
+    if (kUnderSanitizers && std::string(forces) != "variables") continue;
+    const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+      root["samples"] = 16;
+      root["hessian"] = "limited-memory";
+    }, "weight_shift.yaml");
+    const auto out = dir.path() / forces;
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --contact-forces " + forces + " --out " +
+                                  test::quoted(out) + " --max-iterations 3");
+    INFO(forces << ": " << r.all());
+    REQUIRE(r.exitCode == 4);
+    CHECK_THAT(r.output, Contains("contacts l_sole, r_sole; contact forces: " + std::string(forces)));
+    const Json result = readJson(out / "result.json");
+    CHECK(result["contact_forces"] == forces);
+    REQUIRE(result["contacts"].size() == 2);
+    CHECK(result["contacts"][1]["name"] == "r_sole");
+    CHECK(result["contacts"][1]["closure_drift_m"].get<double>() >= 0.0);
+    CHECK(result["contacts"][1]["wrench"].size() == 16);
+    CHECK(result["violation_by_kind"].contains("closure"));
+    CHECK(result["power_fine"].is_null());
+    if (std::string(forces) == "bilevel") CHECK(result["inner"]["status"].size() == 16);
+
+    const auto dynamics = test::runMcopt(
+        "dynamics --robot " + test::quoted(test::sourceDir() / "robots/hrp2/hrp2.urdf") + " --reference-body l_sole --states " +
+        test::quoted(out / "states.json") + " --contacts " + test::quoted(out / "contact_wrenches.json") + " --out " +
+        test::quoted(dir.path() / "dynamics.json"));
+    REQUIRE(dynamics.exitCode == 0);
+    const Json evaluated = readJson(dir.path() / "dynamics.json");
+    REQUIRE(evaluated["results"].size() == 16);
+    double worst = 0.0, largest = 0.0, contactShare = 0.0;
+    for (std::size_t s = 0; s < 16; ++s)
+      for (std::size_t j = 0; j < 30; ++j) {
+        const double expected = result["torques"][s][j].get<double>();
+        worst = std::max(worst, std::abs(evaluated["results"][s]["tau"][j].get<double>() - expected));
+        largest = std::max(largest, std::abs(expected));
+        contactShare = std::max(contactShare, std::abs(evaluated["results"][s]["tau0"][j].get<double>() - expected));
+      }
+    INFO("largest torque " << largest << " N m, worst difference " << worst << ", largest Γ0 − Γ " << contactShare);
+    CHECK(largest > 10.0);
+    CHECK(contactShare > 1.0);  // the second sole does carry load: the check is not Γ0 against Γ0
+    CHECK(worst <= 1e-9 * largest);
+  }
+  // Bad contact wrench files name the file and the field.
+  const auto bad = dir.write("bad_wrenches.json", "{\"contact_surfaces\": \"" +
+                                                     (test::sourceDir() / "robots/hrp2/contacts.yaml").string() +
+                                                     "\", \"contacts\": [{\"surface\": \"r_sole\", \"wrenches\": [[1, 2]]}]}");
+  const auto states = dir.write("one_state.json", "{\"states\": [{}]}");
+  const auto r = test::runMcopt("dynamics --robot " + test::quoted(test::sourceDir() / "robots/hrp2/hrp2.urdf") +
+                                " --states " + test::quoted(states) + " --contacts " + test::quoted(bad));
+  CHECK(r.exitCode == 2);
+  CHECK_THAT(r.errors, Contains(bad.string() + ": contacts[0].wrenches[0]"));
 }

@@ -221,4 +221,28 @@ TEST_CASE("multi-contact outer problem: with the reference contact alone every f
   CHECK(physics.energy == Approx(r.energy).epsilon(1e-12));
 }
 
+TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios evaluate with every formulation",
+          "[outer][multi-contact]") {
+  for (const char* name : {"hrp2_weight_shift.yaml", "hrp2_lean_reach.yaml"}) {
+    Scenario s = loadScenario(test::sourceDir() / "scenarios" / name);
+    s.samples = 20;
+    for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
+      s.contactForces = forces;
+      MotionProblem problem(s);
+      const Eigen::VectorXd x = problem.initialPoint(s.start, s.end);
+      Eigen::VectorXd g, gradient;
+      problem.constraints(x, g);
+      problem.objectiveGradient(x, gradient);
+      INFO(name << ", " << toString(forces));
+      CHECK(std::isfinite(problem.objective(x)));
+      CHECK(g.allFinite());
+      CHECK(gradient.allFinite());
+      CHECK(problem.infeasibleSamples() == 0);  // the initial motion (a still posture) is carried by the soles
+      int closureRows = 0;
+      for (int r = 0; r < problem.constraintCount(); ++r) closureRows += problem.rowKind(r) == ConstraintKind::Closure;
+      CHECK(closureRows >= 6 * 2);
+    }
+  }
+}
+
 }  // namespace mcopt
