@@ -147,8 +147,10 @@ int runMotion(const RunOptions& o) {
   record.solver = solveWithIpopt(problem, x0, settings, [&](const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
-    if (problem.bilevel()) std::printf("   %d", problem.infeasibleSamples());
+    const MotionProblem::InnerStatistics inner = problem.innerStatistics();
+    if (problem.bilevel()) std::printf("   %d", inner.infeasible);
     std::printf("\n");
+    record.history.push_back({r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds, inner});
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
         r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {

@@ -125,6 +125,22 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
                       {"constraints", problem.constraintCount()},
                       {"jacobian_nonzeros", problem.jacobianNonZeros()}};
   if (!record.solver.evaluationError.empty()) result["solver"]["evaluation_error"] = record.solver.evaluationError;
+  Json history = Json::array();
+  for (const IterationRecord& h : record.history) {
+    Json line = {{"iteration", h.iteration},
+                 {"objective", h.objective},
+                 {"violation", h.violation},
+                 {"dual_infeasibility", h.dualInfeasibility},
+                 {"elapsed_seconds", h.elapsedSeconds}};
+    if (problem.bilevel())
+      line["inner"] = {{"optimal", h.inner.optimal},
+                       {"infeasible", h.inner.infeasible},
+                       {"failed", h.inner.failed},
+                       {"mean_iterations", h.inner.meanIterations},
+                       {"solve_seconds", h.inner.solveSeconds}};
+    history.push_back(line);
+  }
+  result["history"] = history;
   result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -21,11 +22,20 @@ struct PostureOutcome {
   double seconds = 0.0;
 };
 
+/// One Ipopt iteration as the progress line shows it, with the bilevel inner problems of the
+/// last evaluation before it (result.json `history`).
+struct IterationRecord {
+  int iteration = 0;
+  double objective = 0.0, violation = 0.0, dualInfeasibility = 0.0, elapsedSeconds = 0.0;
+  MotionProblem::InnerStatistics inner;
+};
+
 struct RunRecord {
   std::string status, message, reason;  ///< reason: why a run that is not optimal ended
   Eigen::VectorXd x;                    ///< the outer problem's variables
   PostureOutcome start, end;
   IpoptOutcome solver;
+  std::vector<IterationRecord> history;
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
 };
 

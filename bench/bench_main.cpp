@@ -8,6 +8,7 @@ namespace mcopt::bench {
 void registerDynamicsBenchmarks();
 void registerInnerBenchmarks();
 void registerSensitivityBenchmarks();
+void registerOptimisationBenchmarks();
 }
 
 int main(int argc, char** argv) {
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   mcopt::bench::registerDynamicsBenchmarks();
   mcopt::bench::registerInnerBenchmarks();
   mcopt::bench::registerSensitivityBenchmarks();
+  mcopt::bench::registerOptimisationBenchmarks();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -208,10 +208,18 @@ bool MotionProblem::contactActive(int contact, int sample) const {
   return insideWindow(static_cast<double>(sample) / (samples_.sampleCount() - 1), windows_[static_cast<std::size_t>(contact)]);
 }
 
-int MotionProblem::infeasibleSamples() const {
-  int count = 0;
-  for (const auto& sample : bilevelSamples_) count += sample->innerResult().status == InnerStatus::Infeasible;
-  return count;
+MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
+  InnerStatistics statistics;
+  for (const auto& sample : bilevelSamples_) {
+    const InnerResult& r = sample->innerResult();
+    statistics.optimal += r.status == InnerStatus::Optimal;
+    statistics.infeasible += r.status == InnerStatus::Infeasible;
+    statistics.failed += r.status == InnerStatus::Failed;
+    statistics.meanIterations += r.iterations;
+    statistics.solveSeconds += 1e-6 * r.solveTimeUs;
+  }
+  if (!bilevelSamples_.empty()) statistics.meanIterations /= static_cast<double>(bilevelSamples_.size());
+  return statistics;
 }
 
 void MotionProblem::buildStructure() {

@@ -102,8 +102,14 @@ class MotionProblem final : public NlpProblem {
   bool bilevel() const { return bilevel_; }
   int forceVariableCount() const { return forces_ ? forces_->variableCount() : 0; }
   int forceVariableStart() const { return forceStart_; }
-  /// Bilevel: samples whose inner problem was infeasible at the last evaluation.
-  int infeasibleSamples() const;
+  /// Bilevel: the inner problems of the last evaluation (all zero otherwise).
+  struct InnerStatistics {
+    int optimal = 0, infeasible = 0, failed = 0;
+    double meanIterations = 0.0;  ///< inner solver iterations per sample
+    double solveSeconds = 0.0;    ///< summed over the samples (threads overlap)
+  };
+  InnerStatistics innerStatistics() const;
+  int infeasibleSamples() const { return innerStatistics().infeasible; }
   /// Whether environment contact i (scenario.contacts order) is in contact at sample s.
   bool contactActive(int contact, int sample) const;
 

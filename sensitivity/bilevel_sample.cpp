@@ -14,7 +14,8 @@ BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurf
   if (contacts_.empty()) throw InputError("bilevel sample: no contact surface given");
   const int n = model.jointCount(), nc = contactCount();
   torque_.setZero(n), g_.setZero(n), linearDv_.setZero(n), linearDa_.setZero(n);
-  for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_}) m->setZero(n, n);
+  for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_, &fixedDq_, &fixedDv_, &fixedDa_})
+    m->setZero(n, n);
   dF_.setZero(6 * nc, 3 * n), stationarity_.setZero(6 * nc, 3 * n), balance_.setZero(6, 3 * n);
   for (auto* m : {&dBFdq_, &dLeastSlackBFdq_, &dWorld_, &dTorqueT_, &dWorldT_}) m->setZero(6, n);
   for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
@@ -36,7 +37,7 @@ void BilevelSample::warmStartFrom(const BilevelSample& other) {
 
 void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives* d,
                              const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& v,
-                             const Eigen::Ref<const Eigen::VectorXd>& a, bool withDerivatives) {
+                             const Eigen::Ref<const Eigen::VectorXd>& a, bool withDerivatives, bool solveKkt) {
   const int n = model.jointCount(), nc = contactCount();
   if (withDerivatives && d == nullptr) throw InputError("bilevel sample: derivatives requested without dynamics derivatives");
   // The inner problem of this sample (formulation.md §5, §7): J1, the contact poses, W0.
@@ -101,17 +102,35 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
     balance_.leftCols(n) = dBFdq_ - d->dwrenchDq;
     balance_.middleCols(n, n) = -d->dwrenchDv;
     balance_.rightCols(n) = -d->dwrenchDa;
-    sensitivity_.solve(stationarity_, balance_, dF_);
+    if (solveKkt) sensitivity_.solve(stationarity_, balance_, dF_);
     hasWrenchDerivative_ = true;
   } else {
     diagnostics_ = SensitivityDiagnostics{};
   }
+  fixedDq_ = d->dtauDq - dJ1Fdq_;
+  fixedDv_ = d->dtauDv;
+  fixedDa_ = d->dtauDa;
+  updateTorqueDerivatives();
+}
+
+void BilevelSample::setWrenchDerivative(const Eigen::Ref<const Eigen::MatrixXd>& dF) {
+  if (dF.rows() != dF_.rows() || dF.cols() != dF_.cols())
+    throw InputError("bilevel sample: wrench derivative of " + std::to_string(dF.rows()) + " × " +
+                     std::to_string(dF.cols()) + ", expected " + std::to_string(dF_.rows()) + " × " +
+                     std::to_string(dF_.cols()));
+  dF_ = dF;
+  updateTorqueDerivatives();
+}
+
+void BilevelSample::updateTorqueDerivatives() {
   // dΓ/dx = dΓ0/dx − (∂J1/∂x) F − J1 dF/dx  (4.8)
-  dTorqueDq_ = d->dtauDq - dJ1Fdq_;
+  const Eigen::MatrixXd& J1 = sample_.wrenchToTorque;
+  const Eigen::Index n = fixedDq_.cols();
+  dTorqueDq_ = fixedDq_;
   dTorqueDq_.noalias() -= J1 * dF_.leftCols(n);
-  dTorqueDv_ = d->dtauDv;
+  dTorqueDv_ = fixedDv_;
   dTorqueDv_.noalias() -= J1 * dF_.middleCols(n, n);
-  dTorqueDa_ = d->dtauDa;
+  dTorqueDa_ = fixedDa_;
   dTorqueDa_.noalias() -= J1 * dF_.rightCols(n);
 }
 

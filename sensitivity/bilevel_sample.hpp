@@ -47,9 +47,19 @@ class BilevelSample {
   /// `data` holds the inverse dynamics of (q, v, a), and `derivatives` their derivatives
   /// when `withDerivatives` is set. Solves the inner problem (warm-started from this
   /// sample's previous result) and fills the outputs below.
+  /// With `solveKkt` false the KKT system is factorised but not solved: dF*/dx is left at
+  /// zero until setWrenchDerivative() (the all-samples layout solves many samples' systems
+  /// together, sensitivity/multi_contact_gradient.hpp).
   void evaluate(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives* derivatives,
                 const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& v,
-                const Eigen::Ref<const Eigen::VectorXd>& a, bool withDerivatives);
+                const Eigen::Ref<const Eigen::VectorXd>& a, bool withDerivatives, bool solveKkt = true);
+
+  /// After evaluate(…, solveKkt = false) with an optimal inner result: the KKT matrix and the
+  /// right-hand side of dF*/d(q, q̇, q̈) (InnerSensitivity::kktMatrix, rightHandSide).
+  const Eigen::MatrixXd& kktMatrix() const { return sensitivity_.kktMatrix(); }
+  void kktRightHandSide(Eigen::MatrixXd& rhs) const { sensitivity_.rightHandSide(stationarity_, balance_, rhs); }
+  /// dF*/d(q, q̇, q̈) solved elsewhere (6nc × 3n); the torque derivatives follow (4.8).
+  void setWrenchDerivative(const Eigen::Ref<const Eigen::MatrixXd>& dF);
 
   /// Starts the next solve from `other`'s result (a neighbouring sample with the same contacts).
   void warmStartFrom(const BilevelSample& other);
@@ -83,7 +93,10 @@ class BilevelSample {
   bool hasWrenchDerivative_ = false;
   double infeasibility_ = 0.0;
   Eigen::VectorXd torque_, g_, linearDv_, linearDa_;
+  void updateTorqueDerivatives();
+
   Eigen::MatrixXd dTorqueDq_, dTorqueDv_, dTorqueDa_, dF_, stationarity_, balance_, dJ1Fdq_, dTorque_, scaled_;
+  Eigen::MatrixXd fixedDq_, fixedDv_, fixedDa_;  ///< ∂Γ/∂x at fixed wrenches
   Eigen::Matrix<double, 6, Eigen::Dynamic> dBFdq_, dLeastSlackBFdq_, dWorld_, dTorqueT_, dWorldT_;
   Vector6 leastSlack_ = Vector6::Zero();
   Eigen::RowVectorXd dInfeasibilityDq_, dInfeasibilityDv_, dInfeasibilityDa_;

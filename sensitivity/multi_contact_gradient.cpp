@@ -11,28 +11,12 @@
 namespace mcopt {
 
 struct MultiContactGradientEvaluator::Workspace {
-  Workspace(const DynamicsModel& model, const std::vector<ContactSurface>& contacts, const MultiContactSettings& s,
-            const SensitivitySettings& sensitivitySettings)
-      : data(model), derivatives(model), sample(model, contacts, s.problem), sensitivity(sensitivitySettings) {
-    const int n = model.jointCount(), nc = static_cast<int>(contacts.size());
-    solver = makeInnerSolver(s.solverName, s.solver);
-    g.setZero(n), linearDv.setZero(n), linearDa.setZero(n);
-    dJ1Fdq.setZero(n, n), dTorque.setZero(n, n);
-    dBFdq.setZero(6, n), dWorld.setZero(6, n), dTorqueT.setZero(6, n), dWorldT.setZero(6, n);
-    stationarity.setZero(6 * nc, 3 * n), balance.setZero(6, 3 * n), dF.setZero(6 * nc, 3 * n);
-    dGammaDq.setZero(n, n), dGammaDv.setZero(n, n), dGammaDa.setZero(n, n), scaled.setZero(n, n);
-    energyGradient.setZero(0), powerTorque.setZero(n), rowQ.setZero(n), rowV.setZero(n), rowA.setZero(n);
+  explicit Workspace(const DynamicsModel& model) : data(model), derivatives(model) {
+    const int n = model.jointCount();
+    powerTorque.setZero(n), rowQ.setZero(n), rowV.setZero(n), rowA.setZero(n);
   }
   DynamicsData data;
   DynamicsDerivatives derivatives;
-  SampleProblem sample;
-  InnerSensitivity sensitivity;
-  std::unique_ptr<InnerSolver> solver;
-  Eigen::VectorXd g, linearDv, linearDa;
-  Eigen::MatrixXd dJ1Fdq, dTorque;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> dBFdq, dWorld, dTorqueT, dWorldT;
-  Eigen::MatrixXd stationarity, balance, dF;
-  Eigen::MatrixXd dGammaDq, dGammaDv, dGammaDa, scaled;
   Eigen::VectorXd energyGradient, powerTorque, rowQ, rowV, rowA;
   double energyDT = 0.0;
   int degenerate = 0, withoutDerivative = 0;
@@ -57,91 +41,39 @@ MultiContactGradientEvaluator::MultiContactGradientEvaluator(const DynamicsModel
     if (!(actuators_.joints[j].resistance > 0.0))
       throw InputError("actuator of joint " + std::to_string(j) +
                        ": winding resistance must be positive for the inner objective (formulation.md §7)");
-  for (int t = 0; t < omp_get_max_threads(); ++t)
-    workspaces_.push_back(std::make_unique<Workspace>(model, contacts_, settings_, sensitivitySettings_));
-  previous_.resize(static_cast<std::size_t>(samples_.sampleCount()));
-  store_.resize(static_cast<std::size_t>(samples_.sampleCount()));
-  sampleKkt_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   if (sensitivitySettings_.layout == KktLayout::AllSamples && sensitivitySettings_.backend == KktBackend::Dense)
     throw InputError("the all-samples KKT layout needs a sparse backend (klu or umfpack)");
+  for (int t = 0; t < omp_get_max_threads(); ++t) workspaces_.push_back(std::make_unique<Workspace>(model));
+  // φ's scale (m g) does not matter here: this evaluator reports the slack, not φ.
+  for (int s = 0; s < samples_.sampleCount(); ++s)
+    bilevel_.emplace_back(model, contacts_, settings_, sensitivitySettings_, 1.0);
 }
 
 MultiContactGradientEvaluator::~MultiContactGradientEvaluator() = default;
 
 void MultiContactGradientEvaluator::prepareSample(Workspace& w, int s, double duration, MultiContactResult& r,
                                                   MultiContactGradient& grad) {
-  const int n = model_.jointCount(), nc = static_cast<int>(contacts_.size());
   TrajectoryResult& motion = r.motion;
   motion.time[s] = samples_.time(s, duration);
   samples_.evaluate(s, controlPoints_, duration, motion.q.col(s), motion.v.col(s), motion.a.col(s));
   inverseDynamicsDerivatives(model_, w.data, w.derivatives, motion.q.col(s), motion.v.col(s), motion.a.col(s));
-  const DynamicsDerivatives& d = w.derivatives;
   r.tau0.col(s) = w.data.tau;
   motion.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
-  w.sample.update(model_, w.data, actuators_, contacts_, motion.v.col(s), motion.a.col(s));
-  InnerResult& inner = previous_[static_cast<std::size_t>(s)];
-  w.solver->solve(w.sample.problem, inner);
+  BilevelSample& sample = bilevel_[static_cast<std::size_t>(s)];
+  sample.evaluate(model_, w.data, &w.derivatives, actuators_, motion.v.col(s), motion.a.col(s), true,
+                  sensitivitySettings_.layout == KktLayout::PerSample);
+  const InnerResult& inner = sample.innerResult();
   r.status[static_cast<std::size_t>(s)] = inner.status;
   r.iterations[s] = inner.iterations;
   r.kktResidual[s] = inner.kktResidual;
   r.wrenches.col(s) = inner.wrenches;
   r.balanceSlack.col(s) = inner.balanceSlack;
-  const Eigen::MatrixXd& J1 = w.sample.wrenchToTorque;
-  motion.tau.col(s) = w.data.tau;
-  motion.tau.col(s).noalias() -= J1 * inner.wrenches;
-
-  // ∂(J1 F)/∂q and ∂(B F)/∂q at the optimal wrenches.
-  w.dJ1Fdq.setZero();
-  w.dBFdq.setZero();
-  for (int i = 0; i < nc; ++i) {
-    const Vector6 wrench = inner.wrenches.segment<6>(6 * i);
-    wrenchMapDerivatives(model_, w.data, w.sample.frames[static_cast<std::size_t>(i)], wrench, w.dWorld, w.dTorque);
-    w.dJ1Fdq += w.dTorque;
-    w.dBFdq += w.dWorld;
-  }
-  SampleStore& store = store_[static_cast<std::size_t>(s)];
-  store.wrenchToTorque = J1;
-  store.fixedWrenchQ = d.dtauDq - w.dJ1Fdq;
-  store.fixedWrenchV = d.dtauDv;
-  store.fixedWrenchA = d.dtauDa;
-  store.dF.setZero(6 * nc, 3 * n);
-  store.hasDerivative = inner.status == InnerStatus::Optimal;
-  if (inner.status == InnerStatus::Optimal) {
-    const SensitivityDiagnostics& diagnostics = w.sensitivity.factorize(w.sample.problem, inner);
-    grad.diagnostics[static_cast<std::size_t>(s)] = diagnostics;
-    w.degenerate += diagnostics.degenerate();
-    const auto& weights = w.sample.weights;
-    w.g = 2.0 * weights.cwiseProduct(motion.tau.col(s)) + w.sample.linear;
-    innerObjectiveTermDerivatives(actuators_, motion.v.col(s), w.linearDv, w.linearDa);
-    for (int i = 0; i < nc; ++i) {
-      transposedWrenchMapDerivatives(model_, w.data, w.sample.frames[static_cast<std::size_t>(i)], w.g,
-                                     inner.balanceMultipliers, w.dTorqueT, w.dWorldT);
-      w.stationarity.block(6 * i, 0, 6, n) = w.dWorldT - w.dTorqueT;
-    }
-    // −J1ᵀ 2 diag(w) (∂Γ/∂x at fixed F) − J1ᵀ diag(∂l/∂x)
-    // (scaled: 2 diag(w) times ∂Γ/∂x at fixed F, in a preallocated buffer: no temporaries)
-    w.scaled.noalias() = 2.0 * weights.asDiagonal() * (d.dtauDq - w.dJ1Fdq);
-    w.stationarity.leftCols(n).noalias() -= J1.transpose() * w.scaled;
-    w.scaled.noalias() = 2.0 * weights.asDiagonal() * d.dtauDv;
-    w.scaled.diagonal() += w.linearDv;
-    w.stationarity.middleCols(n, n).noalias() = -J1.transpose() * w.scaled;
-    w.scaled.noalias() = 2.0 * weights.asDiagonal() * d.dtauDa;
-    w.scaled.diagonal() += w.linearDa;
-    w.stationarity.rightCols(n).noalias() = -J1.transpose() * w.scaled;
-    w.balance.leftCols(n) = w.dBFdq - d.dwrenchDq;
-    w.balance.middleCols(n, n) = -d.dwrenchDv;
-    w.balance.rightCols(n) = -d.dwrenchDa;
-    if (sensitivitySettings_.layout == KktLayout::AllSamples) {
-      sampleKkt_[static_cast<std::size_t>(s)] = w.sensitivity.kktMatrix();
-      w.sensitivity.rightHandSide(w.stationarity, w.balance, store.rhs);
-    } else {
-      w.sensitivity.solve(w.stationarity, w.balance, store.dF);
-    }
-  } else {
-    sampleKkt_[static_cast<std::size_t>(s)].resize(0, 0);
-    grad.diagnostics[static_cast<std::size_t>(s)] = SensitivityDiagnostics{};
+  motion.tau.col(s) = sample.torque();
+  grad.diagnostics[static_cast<std::size_t>(s)] = sample.diagnostics();
+  if (sample.hasWrenchDerivative())
+    w.degenerate += sample.diagnostics().degenerate();
+  else
     ++w.withoutDerivative;
-  }
 }
 
 void MultiContactGradientEvaluator::solveAllSamples() {
@@ -149,39 +81,42 @@ void MultiContactGradientEvaluator::solveAllSamples() {
   // sides share their 3n columns (the blocks do not interact).
   const int count = samples_.sampleCount(), n = model_.jointCount();
   std::vector<Eigen::Triplet<double>> entries;
+  std::vector<Eigen::MatrixXd> rhs(static_cast<std::size_t>(count));
   int size = 0;
   std::vector<int> offset(static_cast<std::size_t>(count), -1);
   for (int s = 0; s < count; ++s) {
-    const Eigen::MatrixXd& K = sampleKkt_[static_cast<std::size_t>(s)];
-    if (!store_[static_cast<std::size_t>(s)].hasDerivative || K.size() == 0) continue;
+    const BilevelSample& sample = bilevel_[static_cast<std::size_t>(s)];
+    if (!sample.hasWrenchDerivative()) continue;
+    const Eigen::MatrixXd& K = sample.kktMatrix();
     offset[static_cast<std::size_t>(s)] = size;
     for (Eigen::Index c = 0; c < K.cols(); ++c)
       for (Eigen::Index r = 0; r < K.rows(); ++r)
         if (K(r, c) != 0.0) entries.emplace_back(size + static_cast<int>(r), size + static_cast<int>(c), K(r, c));
+    sample.kktRightHandSide(rhs[static_cast<std::size_t>(s)]);
     size += static_cast<int>(K.rows());
   }
   if (size == 0) return;
   Eigen::SparseMatrix<double> blocks(size, size);
   blocks.setFromTriplets(entries.begin(), entries.end());
-  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(size, 3 * n);
+  Eigen::MatrixXd stacked = Eigen::MatrixXd::Zero(size, 3 * n);
   for (int s = 0; s < count; ++s)
     if (offset[static_cast<std::size_t>(s)] >= 0)
-      rhs.middleRows(offset[static_cast<std::size_t>(s)], store_[static_cast<std::size_t>(s)].rhs.rows()) =
-          store_[static_cast<std::size_t>(s)].rhs;
+      stacked.middleRows(offset[static_cast<std::size_t>(s)], rhs[static_cast<std::size_t>(s)].rows()) =
+          rhs[static_cast<std::size_t>(s)];
   Eigen::MatrixXd solution;
   if (sensitivitySettings_.backend == KktBackend::SparseUmfpack) {
     Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu(blocks);
     if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (UMFPACK) failed");
-    solution = lu.solve(rhs);
+    solution = lu.solve(stacked);
   } else {
     Eigen::KLU<Eigen::SparseMatrix<double>> lu(blocks);
     if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (KLU) failed");
-    solution = lu.solve(rhs);
+    solution = lu.solve(stacked);
   }
   const int nc = static_cast<int>(contacts_.size());
   for (int s = 0; s < count; ++s)
     if (offset[static_cast<std::size_t>(s)] >= 0)
-      store_[static_cast<std::size_t>(s)].dF = solution.middleRows(offset[static_cast<std::size_t>(s)], 6 * nc);
+      bilevel_[static_cast<std::size_t>(s)].setWrenchDerivative(solution.middleRows(offset[static_cast<std::size_t>(s)], 6 * nc));
 }
 
 void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double duration, MultiContactResult& r,
@@ -189,25 +124,19 @@ void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double dur
   const int n = model_.jointCount();
   const int count = samples_.sampleCount(), m = samples_.parametrization().parametersPerJoint();
   TrajectoryResult& motion = r.motion;
-  const SampleStore& store = store_[static_cast<std::size_t>(s)];
-  const Eigen::MatrixXd& J1 = store.wrenchToTorque;
-  // dΓ/dx = dΓ0/dx − (∂J1/∂x) F − J1 dF/dx  (4.8)
-  w.dGammaDq = store.fixedWrenchQ;
-  w.dGammaDq.noalias() -= J1 * store.dF.leftCols(n);
-  w.dGammaDv = store.fixedWrenchV;
-  w.dGammaDv.noalias() -= J1 * store.dF.middleCols(n, n);
-  w.dGammaDa = store.fixedWrenchA;
-  w.dGammaDa.noalias() -= J1 * store.dF.rightCols(n);
+  const BilevelSample& sample = bilevel_[static_cast<std::size_t>(s)];
+  const Eigen::MatrixXd& dF = sample.wrenchesDstate();
 
   SampleTorqueJacobian& torqueBlock = grad.torqueAndEnergy.torque[static_cast<std::size_t>(s)];
-  samples_.chainRule(s, duration, w.dGammaDq, w.dGammaDv, w.dGammaDa, torqueBlock.dtauDx, torqueBlock.parameters);
-  SampledTrajectory::durationDerivative(duration, w.dGammaDv, w.dGammaDa, motion.v.col(s), motion.a.col(s),
+  samples_.chainRule(s, duration, sample.torqueDq(), sample.torqueDv(), sample.torqueDa(), torqueBlock.dtauDx,
+                     torqueBlock.parameters);
+  SampledTrajectory::durationDerivative(duration, sample.torqueDv(), sample.torqueDa(), motion.v.col(s), motion.a.col(s),
                                         torqueBlock.dtauDT);
   SampleWrenchJacobian& wrenchBlock = grad.wrenches[static_cast<std::size_t>(s)];
-  samples_.chainRule(s, duration, store.dF.leftCols(n), store.dF.middleCols(n, n), store.dF.rightCols(n),
-                     wrenchBlock.dFdx, wrenchBlock.parameters);
-  SampledTrajectory::durationDerivative(duration, store.dF.middleCols(n, n), store.dF.rightCols(n), motion.v.col(s),
-                                        motion.a.col(s), wrenchBlock.dFdT);
+  samples_.chainRule(s, duration, dF.leftCols(n), dF.middleCols(n, n), dF.rightCols(n), wrenchBlock.dFdx,
+                     wrenchBlock.parameters);
+  SampledTrajectory::durationDerivative(duration, dF.middleCols(n, n), dF.rightCols(n), motion.v.col(s), motion.a.col(s),
+                                        wrenchBlock.dFdT);
 
   // Energy (as TrajectoryGradientEvaluator, with Γ and dΓ/dx of the chosen wrenches).
   const LocalParameterWeights& local = samples_.weights(s);
@@ -228,9 +157,9 @@ void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double dur
     w.rowA[j] = active ? weight * p.dAcceleration : 0.0;
     directDT -= w.rowV[j] * motion.v(j, s) + 2.0 * w.rowA[j] * motion.a(j, s);
   }
-  w.rowQ.noalias() = w.dGammaDq.transpose() * w.powerTorque;
-  w.rowV.noalias() += w.dGammaDv.transpose() * w.powerTorque;
-  w.rowA.noalias() += w.dGammaDa.transpose() * w.powerTorque;
+  w.rowQ.noalias() = sample.torqueDq().transpose() * w.powerTorque;
+  w.rowV.noalias() += sample.torqueDv().transpose() * w.powerTorque;
+  w.rowA.noalias() += sample.torqueDa().transpose() * w.powerTorque;
   for (int j = 0; j < n; ++j)
     for (int l = 0; l < local.count; ++l)
       w.energyGradient[j * m + local.parameter[static_cast<std::size_t>(l)]] +=
@@ -265,18 +194,14 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   const int threads = static_cast<int>(workspaces_.size());
 #pragma omp parallel num_threads(threads)
   {
+    // One contiguous block of samples per thread: a sample without a result of its own (the
+    // first evaluation) is warm-started from its predecessor in the block.
     const int t = omp_get_thread_num(), used = omp_get_num_threads();
     const int first = count * t / used, last = count * (t + 1) / used;
     Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
     for (int s = first; s < last; ++s) {
-      if (s > first && settings_.solver.warmStart) {  // warm start along the motion
-        const InnerResult& before = previous_[static_cast<std::size_t>(s - 1)];
-        InnerResult& current = previous_[static_cast<std::size_t>(s)];
-        current.wrenches = before.wrenches;
-        current.activeSet = before.activeSet;
-        current.inequalityMultipliers = before.inequalityMultipliers;
-        current.coneMultipliers = before.coneMultipliers;
-      }
+      if (s > first && settings_.solver.warmStart && !bilevel_[static_cast<std::size_t>(s)].hasResult())
+        bilevel_[static_cast<std::size_t>(s)].warmStartFrom(bilevel_[static_cast<std::size_t>(s - 1)]);
       prepareSample(w, s, duration, r, grad);
     }
   }
@@ -291,7 +216,7 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   r.innerTimeUs = 0.0;
   r.infeasibleSamples = r.failedSamples = 0;
   for (int s = 0; s < count; ++s) {
-    r.innerTimeUs += previous_[static_cast<std::size_t>(s)].solveTimeUs;
+    r.innerTimeUs += bilevel_[static_cast<std::size_t>(s)].innerResult().solveTimeUs;
     r.infeasibleSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Infeasible;
     r.failedSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Failed;
   }

@@ -14,13 +14,16 @@
 //   ∂(B F − W0)/∂x = ∂(B F)/∂q (q only) − ∂W0/∂x
 // Samples whose inner result is not optimal have no derivative: their dF is left at zero
 // and they are counted; degenerate samples (weakly active constraints, near-singular KKT)
-// are counted too (SensitivityDiagnostics).
+// are counted too (SensitivityDiagnostics). Each sample is a BilevelSample
+// (bilevel_sample.hpp, which the outer problem uses too), warm-started from its own previous
+// result, or on the first evaluation from its predecessor.
 
 #include <memory>
 #include <vector>
 
 #include "core/trajectory_gradient.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
+#include "sensitivity/bilevel_sample.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt {
@@ -51,17 +54,10 @@ class MultiContactGradientEvaluator {
 
  private:
   struct Workspace;
-  /// Per sample, kept between the passes: what dΓ/dx needs besides dF/dx, and the KKT system.
-  struct SampleStore {
-    Eigen::MatrixXd wrenchToTorque;              ///< J1
-    Eigen::MatrixXd fixedWrenchQ, fixedWrenchV, fixedWrenchA;  ///< ∂Γ/∂x at fixed F
-    Eigen::MatrixXd dF;                          ///< 6nc × 3n
-    Eigen::MatrixXd rhs;                         ///< all-samples layout: this sample's right-hand side
-    bool hasDerivative = false;
-  };
-  /// Pass 1: dynamics, inner solve, KKT factorisation (per-sample layout: also dF).
+  /// Pass 1: dynamics and the sample's inner solve, KKT factorisation and (per-sample
+  /// layout) dF.
   void prepareSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
-  /// Pass 3: dΓ/dx, the chain rule through the splines, the energy.
+  /// Pass 3: the chain rule through the splines, the energy.
   void finishSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
   /// Pass 2 of the all-samples layout: one block-diagonal sparse factorisation and solve.
   void solveAllSamples();
@@ -74,9 +70,7 @@ class MultiContactGradientEvaluator {
   SensitivitySettings sensitivitySettings_;
   Eigen::MatrixXd controlPoints_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
-  std::vector<InnerResult> previous_;
-  std::vector<SampleStore> store_;
-  std::vector<Eigen::MatrixXd> sampleKkt_;  ///< all-samples layout: each sample's KKT matrix
+  std::vector<BilevelSample> bilevel_;  ///< one per sample
 };
 
 }  // namespace mcopt

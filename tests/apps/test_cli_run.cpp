@@ -310,7 +310,17 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
     CHECK(result["contacts"][1]["wrench"].size() == 16);
     CHECK(result["violation_by_kind"].contains("closure"));
     CHECK(result["power_fine"].is_null());
-    if (std::string(forces) == "bilevel") CHECK(result["inner"]["status"].size() == 16);
+    // The iteration history, with the inner problems' counts in the bilevel formulation.
+    REQUIRE(result["history"].size() == 4);  // iterations 0 … 3
+    CHECK(result["history"][3]["iteration"] == 3);
+    if (std::string(forces) == "bilevel") {
+      CHECK(result["inner"]["status"].size() == 16);
+      const Json& inner = result["history"][3]["inner"];
+      CHECK(inner["optimal"].get<int>() + inner["infeasible"].get<int>() + inner["failed"].get<int>() == 16);
+      CHECK(inner["mean_iterations"].get<double>() >= 0.0);
+    } else {
+      CHECK_FALSE(result["history"][3].contains("inner"));
+    }
 
     const auto dynamics = test::runMcopt(
         "dynamics --robot " + test::quoted(test::sourceDir() / "robots/hrp2/hrp2.urdf") + " --reference-body l_sole --states " +

@@ -1,8 +1,9 @@
 #pragma once
-// An NlpProblem's sparse Jacobian as a dense matrix, and its declared pattern, for the
-// derivative tests of the outer problems.
+// An NlpProblem's sparse Jacobian as a dense matrix, its declared pattern, and its exact
+// derivatives' errors against central differences, for the derivative tests of the outer problems.
 #include <Eigen/Core>
 
+#include "common/finite_differences.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 
 namespace mcopt::test {
@@ -21,6 +22,35 @@ inline Eigen::MatrixXd declaredPattern(const NlpProblem& problem) {
   for (Eigen::Index k = 0; k < problem.jacobianRows().size(); ++k)
     pattern(problem.jacobianRows()[k], problem.jacobianColumns()[k]) = 1.0;
   return pattern;
+}
+
+struct DerivativeErrors {
+  double gradient = 0.0, jacobian = 0.0, offPattern = 0.0;
+};
+
+/// Relative errors |exact − differences| / (1 + |differences|) of the objective's gradient
+/// and of the Jacobian against central differences with step h, and the largest difference
+/// off the declared pattern.
+inline DerivativeErrors derivativeErrors(NlpProblem& problem, Eigen::VectorXd x, double h) {
+  Eigen::VectorXd gradient;
+  problem.objectiveGradient(x, gradient);
+  const Eigen::MatrixXd jacobian = denseJacobian(problem, x);
+  const Eigen::MatrixXd pattern = declaredPattern(problem);
+  const Eigen::MatrixXd fd = centralDifferences(x, h, [&] {
+    Eigen::VectorXd out(1 + problem.constraintCount());
+    out[0] = problem.objective(x);
+    Eigen::VectorXd g;
+    problem.constraints(x, g);
+    out.tail(problem.constraintCount()) = g;
+    return out;
+  });
+  DerivativeErrors e;
+  const Eigen::VectorXd gradientFd = fd.row(0).transpose();
+  e.gradient = ((gradient - gradientFd).array().abs() / (1.0 + gradientFd.array().abs())).maxCoeff();
+  const Eigen::MatrixXd jacobianFd = fd.bottomRows(problem.constraintCount());
+  e.jacobian = ((jacobian - jacobianFd).array().abs() / (1.0 + jacobianFd.array().abs())).maxCoeff();
+  e.offPattern = (jacobianFd.array() * (1.0 - pattern.array())).abs().maxCoeff();
+  return e;
 }
 
 }  // namespace mcopt::test

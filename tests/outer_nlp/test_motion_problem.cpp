@@ -19,33 +19,15 @@ namespace mcopt {
 
 namespace {
 
-/// Largest |exact − differences| / (1 + |differences|) and whether every entry off the
-/// declared pattern is zero in the differences.
-void checkDerivatives(NlpProblem& problem, Eigen::VectorXd x, double h, double tolerance) {
-  Eigen::VectorXd gradient;
-  problem.objectiveGradient(x, gradient);
-  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
-  const Eigen::MatrixXd pattern = test::declaredPattern(problem);
-  const Eigen::MatrixXd fd = test::centralDifferences(x, h, [&] {
-    Eigen::VectorXd out(1 + problem.constraintCount());
-    out[0] = problem.objective(x);
-    Eigen::VectorXd g;
-    problem.constraints(x, g);
-    out.tail(problem.constraintCount()) = g;
-    return out;
-  });
-  const Eigen::VectorXd gradientFd = fd.row(0).transpose();
-  const double gradientError =
-      ((gradient - gradientFd).array().abs() / (1.0 + gradientFd.array().abs())).maxCoeff();
-  const Eigen::MatrixXd jacobianFd = fd.bottomRows(problem.constraintCount());
-  const double jacobianError =
-      ((jacobian - jacobianFd).array().abs() / (1.0 + jacobianFd.array().abs())).maxCoeff();
-  const double offPattern = (jacobianFd.array() * (1.0 - pattern.array())).abs().maxCoeff();
-  INFO("gradient error " << gradientError << ", Jacobian error " << jacobianError << ", largest difference off the pattern "
-                         << offPattern);
-  CHECK(gradientError < tolerance);
-  CHECK(jacobianError < tolerance);
-  CHECK(offPattern < tolerance);
+/// The exact gradient and Jacobian within `tolerance` of central differences, and nothing off
+/// the declared pattern.
+void checkDerivatives(NlpProblem& problem, const Eigen::VectorXd& x, double h, double tolerance) {
+  const test::DerivativeErrors e = test::derivativeErrors(problem, x, h);
+  INFO("gradient error " << e.gradient << ", Jacobian error " << e.jacobian << ", largest difference off the pattern "
+                         << e.offPattern);
+  CHECK(e.gradient < tolerance);
+  CHECK(e.jacobian < tolerance);
+  CHECK(e.offPattern < tolerance);
 }
 
 Eigen::VectorXd perturbed(const Eigen::VectorXd& x, int count, double size, unsigned seed) {

@@ -18,34 +18,6 @@ namespace mcopt {
 
 namespace {
 
-struct DerivativeErrors {
-  double gradient = 0.0, jacobian = 0.0, offPattern = 0.0;
-};
-
-/// Relative errors |exact − differences| / (1 + |differences|) over the objective's gradient
-/// and the Jacobian, and the largest difference off the declared pattern.
-DerivativeErrors derivativeErrors(MotionProblem& problem, Eigen::VectorXd x, double h) {
-  Eigen::VectorXd gradient;
-  problem.objectiveGradient(x, gradient);
-  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
-  const Eigen::MatrixXd pattern = test::declaredPattern(problem);
-  const Eigen::MatrixXd fd = test::centralDifferences(x, h, [&] {
-    Eigen::VectorXd out(1 + problem.constraintCount());
-    out[0] = problem.objective(x);
-    Eigen::VectorXd g;
-    problem.constraints(x, g);
-    out.tail(problem.constraintCount()) = g;
-    return out;
-  });
-  DerivativeErrors e;
-  const Eigen::VectorXd gradientFd = fd.row(0).transpose();
-  e.gradient = ((gradient - gradientFd).array().abs() / (1.0 + gradientFd.array().abs())).maxCoeff();
-  const Eigen::MatrixXd jacobianFd = fd.bottomRows(problem.constraintCount());
-  e.jacobian = ((jacobian - jacobianFd).array().abs() / (1.0 + jacobianFd.array().abs())).maxCoeff();
-  e.offPattern = (jacobianFd.array() * (1.0 - pattern.array())).abs().maxCoeff();
-  return e;
-}
-
 Scenario weightShift(int samples) {
   Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
   s.samples = samples;
@@ -96,7 +68,7 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
         MotionProblem problem(s);
         Eigen::VectorXd x = perturbedMotion(problem, 0.05, 7);
         if (freeDuration) x[problem.parametrization().parameterCount()] = 2.2;
-        const DerivativeErrors e = derivativeErrors(problem, x, 1e-6);
+        const test::DerivativeErrors e = test::derivativeErrors(problem, x, 1e-6);
         INFO(toString(forces) << (hand ? ", three contacts" : ", two contacts") << (freeDuration ? ", free T" : "")
                               << ": gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern "
                               << e.offPattern << "; infeasible samples " << problem.infeasibleSamples());
