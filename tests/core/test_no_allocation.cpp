@@ -12,6 +12,7 @@
 #include "core/kinematics.hpp"
 #include "core/robot_files.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
+#include "outer_nlp/motion_problem.hpp"
 #include "sensitivity/multi_contact_gradient.hpp"
 
 namespace {
@@ -106,4 +107,34 @@ TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) alloca
   evaluator.evaluate(x, 1.5, result, gradient);
   CHECK(allocations.load() - before == 0);
   CHECK(gradient.samplesWithoutDerivative == 0);
+}
+
+TEST_CASE("the outer problem's evaluation allocates nothing once warm: one contact and each multi-contact formulation",
+          "[outer][allocation]") {
+  // What Ipopt calls per iterate: objective, gradient, constraints, Jacobian values.
+  for (const char* file : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml"})
+    for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
+      Scenario scenario = loadScenario(test::sourceDir() / "scenarios" / file);
+      scenario.samples = 20;
+      scenario.contactForces = forces;
+      MotionProblem problem(scenario);
+      Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end), gradient, constraints, jacobian;
+      double objective = 0.0;
+      auto evaluateAll = [&] {
+        objective = problem.objective(x);
+        problem.objectiveGradient(x, gradient);
+        problem.constraints(x, constraints);
+        problem.jacobianValues(x, jacobian);
+      };
+      evaluateAll();  // set-up: buffers sized, inner solvers warm
+      std::mt19937 rng(9);
+      x.head(problem.parametrization().parameterCount()) +=
+          test::randomVector(rng, problem.parametrization().parameterCount(), 0.005);
+      const long before = allocations.load();
+      evaluateAll();
+      const long during = allocations.load() - before;  // read before INFO, which allocates its message
+      INFO(file << ", " << toString(forces));
+      CHECK(during == 0);
+      CHECK(std::isfinite(objective));
+    }
 }
