@@ -59,7 +59,7 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
   outcome.seconds = result.seconds;
   const bool usable = result.x.size() == guess.size() && result.x.allFinite();
   outcome.staticPowerAfter = usable ? problem.staticPower(result.x) : outcome.staticPowerBefore;
-  std::cout << "  " << which << " posture: " << result.status << " after " << result.iterations
+  std::cout << "  " << which << " posture: " << toString(result.status) << " after " << result.iterations
             << " iterations, static power " << std::setprecision(4) << outcome.staticPowerBefore << " → "
             << outcome.staticPowerAfter << " W (" << std::setprecision(3) << result.seconds << " s)\n";
   return usable ? result.x : guess;
@@ -70,7 +70,7 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
 void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRecord& sofar, const IterationReport& r,
                      double optimisationSeconds, double totalSeconds) {
   RunRecord checkpoint = sofar;
-  checkpoint.status = "running";
+  checkpoint.status = OuterStatus::Running;
   checkpoint.message = "Ipopt was running when this was written";
   checkpoint.reason = "checkpoint after iteration " + std::to_string(r.iteration) +
                       "; the run had not ended (a run that ends overwrites it)";
@@ -168,22 +168,22 @@ int runMotion(const RunOptions& o) {
   record.x = record.solver.x.size() == x0.size() && record.solver.x.allFinite() ? record.solver.x : x0;
   if (record.solver.x.size() != x0.size()) record.reason = "Ipopt returned no iterate; the initial motion is written";
   if (!record.solver.evaluationError.empty()) record.reason = "evaluation failed: " + record.solver.evaluationError;
-  if (record.status == "interrupted") record.reason = "interrupted by a signal; the last iterate is written";
-  else if (!record.solver.optimal && record.reason.empty()) record.reason = "Ipopt: " + record.solver.message;
+  if (record.status == OuterStatus::Interrupted) record.reason = "interrupted by a signal; the last iterate is written";
+  else if (!record.solver.optimal() && record.reason.empty()) record.reason = "Ipopt: " + record.solver.message;
   record.totalSeconds = seconds(clock);
   const auto [energy, violation] = writeRunOutput(o.out, problem, record);
 
   std::cout << "\nEXIT: " << record.message << "\n"
-            << "  status             " << record.status << "\n"
+            << "  status             " << toString(record.status) << "\n"
             << std::setprecision(6) << "  energy             " << energy << " J  (∫ Σ max(P, 0) dt at the samples)\n"
             << "  max violation      " << std::setprecision(3) << violation << "\n"
             << "  iterations         " << record.solver.iterations << "\n"
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
             << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";
-  if (!record.reason.empty() && !record.solver.optimal) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
-  if (record.status == "interrupted") return kExitInterrupted;
-  return record.solver.optimal ? 0 : kExitNotOptimal;
+  if (!record.reason.empty() && !record.solver.optimal()) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
+  if (record.status == OuterStatus::Interrupted) return kExitInterrupted;
+  return record.solver.optimal() ? 0 : kExitNotOptimal;
 }
 
 }  // namespace

@@ -19,7 +19,7 @@ Json posture(const PostureOutcome& p) {
   Json j;
   j["optimised"] = p.optimised;
   if (!p.optimised) return j;
-  j["status"] = p.status;
+  j["status"] = toString(p.status);
   j["static_power_before_W"] = p.staticPowerBefore;
   j["static_power_after_W"] = p.staticPowerAfter;
   j["iterations"] = p.iterations;
@@ -45,7 +45,7 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   const bool fine = r.fineTime.size() > 0;
 
   Json result;
-  result["status"] = record.status;
+  result["status"] = toString(record.status);
   result["energy"] = r.energy;
   result["max_violation"] = violations.overall;
   result["message"] = record.message;
@@ -114,7 +114,7 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   result["violation_by_kind"] = byKind;
   if (violations.worstRow >= 0) result["worst_constraint"] = problem.rowName(violations.worstRow);
   result["solver"] = {{"name", "ipopt"},
-                      {"status", record.solver.status},
+                      {"status", toString(record.solver.status)},
                       {"message", record.solver.message},
                       {"iterations", record.solver.iterations},
                       {"objective_evaluations", record.solver.objectiveEvaluations},

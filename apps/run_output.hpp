@@ -16,7 +16,7 @@ namespace mcopt::cli {
 /// One static posture found by configuration optimisation (report §3.5).
 struct PostureOutcome {
   bool optimised = false;
-  std::string status;
+  OuterStatus status = OuterStatus::InternalError;
   double staticPowerBefore = 0.0, staticPowerAfter = 0.0;  ///< [W]
   int iterations = 0;
   double seconds = 0.0;
@@ -31,7 +31,8 @@ struct IterationRecord {
 };
 
 struct RunRecord {
-  std::string status, message, reason;  ///< reason: why a run that is not optimal ended
+  OuterStatus status = OuterStatus::InternalError;
+  std::string message, reason;  ///< reason: why a run that is not optimal ended
   Eigen::VectorXd x;                    ///< the outer problem's variables
   PostureOutcome start, end;
   IpoptOutcome solver;

@@ -43,7 +43,7 @@ void optimisation(benchmark::State& state, const std::string& file, ContactForce
   state.counters["iterations"] = outcome.iterations;
   state.counters["s_per_iteration"] = seconds / std::max(1, outcome.iterations);
   state.counters["violation"] = violation;
-  state.counters["optimal"] = outcome.optimal ? 1 : 0;
+  state.counters["optimal"] = outcome.optimal() ? 1 : 0;
 }
 
 }  // namespace

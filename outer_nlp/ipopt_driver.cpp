@@ -19,25 +19,27 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
-/// Ipopt's outcome in our words (result.json's `status`) and in its own.
-std::pair<std::string, std::string> describe(Ipopt::SolverReturn status) {
+/// Ipopt's outcome as ours, with its own words.
+std::pair<OuterStatus, std::string> describe(Ipopt::SolverReturn status) {
   switch (status) {
-    case Ipopt::SUCCESS: return {"optimal", "Optimal Solution Found"};
-    case Ipopt::MAXITER_EXCEEDED: return {"maximum_iterations", "Maximum Number of Iterations Exceeded"};
-    case Ipopt::CPUTIME_EXCEEDED: return {"maximum_cpu_time", "Maximum CPU time exceeded"};
-    case Ipopt::STOP_AT_TINY_STEP: return {"tiny_step", "Search Direction is becoming Too Small"};
-    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return {"acceptable", "Solved To Acceptable Level"};
-    case Ipopt::LOCAL_INFEASIBILITY: return {"infeasible", "Converged to a point of local infeasibility"};
-    case Ipopt::USER_REQUESTED_STOP: return {"interrupted", "Stopping optimization at current point as requested by user"};
-    case Ipopt::FEASIBLE_POINT_FOUND: return {"feasible_point_found", "Feasible point for square problem found"};
-    case Ipopt::DIVERGING_ITERATES: return {"diverging", "Iterates diverging; problem might be unbounded"};
-    case Ipopt::RESTORATION_FAILURE: return {"restoration_failed", "Restoration Phase Failed"};
-    case Ipopt::ERROR_IN_STEP_COMPUTATION: return {"error_in_step_computation", "Error in step computation"};
-    case Ipopt::INVALID_NUMBER_DETECTED: return {"invalid_number", "Invalid number in NLP function or derivative detected"};
-    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return {"too_few_degrees_of_freedom", "Problem has too few degrees of freedom"};
-    case Ipopt::INVALID_OPTION: return {"invalid_option", "Invalid option"};
-    case Ipopt::OUT_OF_MEMORY: return {"out_of_memory", "Not enough memory"};
-    default: return {"internal_error", "Internal error"};
+    case Ipopt::SUCCESS: return {OuterStatus::Optimal, "Optimal Solution Found"};
+    case Ipopt::MAXITER_EXCEEDED: return {OuterStatus::MaximumIterations, "Maximum Number of Iterations Exceeded"};
+    case Ipopt::CPUTIME_EXCEEDED: return {OuterStatus::MaximumCpuTime, "Maximum CPU time exceeded"};
+    case Ipopt::STOP_AT_TINY_STEP: return {OuterStatus::TinyStep, "Search Direction is becoming Too Small"};
+    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return {OuterStatus::Acceptable, "Solved To Acceptable Level"};
+    case Ipopt::LOCAL_INFEASIBILITY: return {OuterStatus::Infeasible, "Converged to a point of local infeasibility"};
+    case Ipopt::USER_REQUESTED_STOP:
+      return {OuterStatus::Interrupted, "Stopping optimization at current point as requested by user"};
+    case Ipopt::FEASIBLE_POINT_FOUND: return {OuterStatus::FeasiblePointFound, "Feasible point for square problem found"};
+    case Ipopt::DIVERGING_ITERATES: return {OuterStatus::Diverging, "Iterates diverging; problem might be unbounded"};
+    case Ipopt::RESTORATION_FAILURE: return {OuterStatus::RestorationFailed, "Restoration Phase Failed"};
+    case Ipopt::ERROR_IN_STEP_COMPUTATION: return {OuterStatus::ErrorInStepComputation, "Error in step computation"};
+    case Ipopt::INVALID_NUMBER_DETECTED:
+      return {OuterStatus::InvalidNumber, "Invalid number in NLP function or derivative detected"};
+    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return {OuterStatus::TooFewDegreesOfFreedom, "Problem has too few degrees of freedom"};
+    case Ipopt::INVALID_OPTION: return {OuterStatus::InvalidOption, "Invalid option"};
+    case Ipopt::OUT_OF_MEMORY: return {OuterStatus::OutOfMemory, "Not enough memory"};
+    default: return {OuterStatus::InternalError, "Internal error"};
   }
 }
 
@@ -50,6 +52,9 @@ class ProblemTnlp final : public Ipopt::TNLP {
     problem_.variableBounds(xLower_, xUpper_);
     problem_.constraintBounds(gLower_, gUpper_);
   }
+
+  /// finalize_solution was called: the outcome holds Ipopt's status.
+  bool finalized() const { return finalized_; }
 
   bool get_nlp_info(Index& n, Index& m, Index& nnzJacobian, Index& nnzHessian, IndexStyleEnum& style) override {
     n = problem_.variableCount();
@@ -150,7 +155,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
                          const Number*, const Number*, Number objective, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
     std::tie(outcome_.status, outcome_.message) = describe(status);
-    outcome_.optimal = status == Ipopt::SUCCESS;
+    finalized_ = true;
     outcome_.objective = objective;
     if (x != nullptr) outcome_.x = copy(x, n);
   }
@@ -198,6 +203,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
   std::chrono::steady_clock::time_point clock_;
   bool hessian_;
   Eigen::VectorXd jacobian_, iterate_;
+  bool finalized_ = false;
 };
 
 void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
@@ -216,6 +222,29 @@ void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
 }
 
 }  // namespace
+
+const char* toString(OuterStatus status) {
+  switch (status) {
+    case OuterStatus::Running: return "running";
+    case OuterStatus::Optimal: return "optimal";
+    case OuterStatus::Acceptable: return "acceptable";
+    case OuterStatus::MaximumIterations: return "maximum_iterations";
+    case OuterStatus::MaximumCpuTime: return "maximum_cpu_time";
+    case OuterStatus::TinyStep: return "tiny_step";
+    case OuterStatus::Infeasible: return "infeasible";
+    case OuterStatus::Interrupted: return "interrupted";
+    case OuterStatus::FeasiblePointFound: return "feasible_point_found";
+    case OuterStatus::Diverging: return "diverging";
+    case OuterStatus::RestorationFailed: return "restoration_failed";
+    case OuterStatus::ErrorInStepComputation: return "error_in_step_computation";
+    case OuterStatus::InvalidNumber: return "invalid_number";
+    case OuterStatus::TooFewDegreesOfFreedom: return "too_few_degrees_of_freedom";
+    case OuterStatus::InvalidOption: return "invalid_option";
+    case OuterStatus::OutOfMemory: return "out_of_memory";
+    case OuterStatus::InternalError: return "internal_error";
+  }
+  return "internal_error";
+}
 
 IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, const IpoptSettings& settings,
                             const std::function<bool(const IterationReport&)>& onIteration) {
@@ -237,13 +266,14 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
 
   IpoptOutcome outcome;
   const auto clock = std::chrono::steady_clock::now();
-  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new ProblemTnlp(problem, start, outcome, onIteration, settings.finiteDifferenceHessian);
+  auto* adapter = new ProblemTnlp(problem, start, outcome, onIteration, settings.finiteDifferenceHessian);
+  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = adapter;  // owns it
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
   const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
   if (Ipopt::IsValid(statistics)) outcome.iterations = statistics->IterationCount();
-  if (outcome.status.empty()) {
-    outcome.status = status == Ipopt::Invalid_Option ? "invalid_option" : "internal_error";
+  if (!adapter->finalized()) {
+    outcome.status = status == Ipopt::Invalid_Option ? OuterStatus::InvalidOption : OuterStatus::InternalError;
     outcome.message = "Ipopt stopped before it had an iterate (return code " + std::to_string(static_cast<int>(status)) + ")";
   }
   return outcome;

@@ -14,6 +14,16 @@
 
 namespace mcopt {
 
+/// How an outer solve ended (Ipopt's SolverReturn in our words), and `Running` for a
+/// checkpoint of a solve still under way. toString gives result.json's `status`.
+enum class OuterStatus {
+  Running, Optimal, Acceptable, MaximumIterations, MaximumCpuTime, TinyStep, Infeasible, Interrupted,
+  FeasiblePointFound, Diverging, RestorationFailed, ErrorInStepComputation, InvalidNumber, TooFewDegreesOfFreedom,
+  InvalidOption, OutOfMemory, InternalError
+};
+/// "running", "optimal", "acceptable", "maximum_iterations", … (docs/scenarios.md, "Results").
+const char* toString(OuterStatus status);
+
 struct IpoptOutcome;
 
 struct IterationReport {
@@ -29,9 +39,9 @@ struct IterationReport {
 };
 
 struct IpoptOutcome {
-  std::string status;          ///< optimal, acceptable, maximum_iterations, interrupted, infeasible, …
+  OuterStatus status = OuterStatus::InternalError;
   std::string message;         ///< Ipopt's words, e.g. "Optimal Solution Found"
-  bool optimal = false;        ///< Ipopt's SUCCESS
+  bool optimal() const { return status == OuterStatus::Optimal; }  ///< Ipopt's SUCCESS
   Eigen::VectorXd x;           ///< the iterate handed back by Ipopt (empty when it never got one)
   double objective = 0.0;
   int iterations = 0;
