@@ -5,6 +5,8 @@
 #include <IpSolveStatistics.hpp>
 #include <IpTNLP.hpp>
 
+#include <mutex>
+
 #include "inner_qp/inner_nlp.hpp"
 
 namespace mcopt {
@@ -155,6 +157,12 @@ RunOutcome runIpopt(Ipopt::IpoptApplication* app, const ContactProblem& problem,
     return outcome;
   }
   Ipopt::SmartPtr<Ipopt::TNLP> tnlp = new InnerTnlp(nlp, x, outcome);
+  // MUMPS is not thread-safe, and Ipopt 3.11 does not guard it (Ipopt only avoids calling
+  // MUMPS from parallel threads since 3.14, coin-or/Ipopt#733): two samples solved at once on
+  // two threads crashed the bilevel outer problem (SIGSEGV / SIGFPE). Every inner Ipopt solve
+  // of the process is therefore serialised; the other inner solvers run in parallel.
+  static std::mutex mumps;
+  const std::lock_guard<std::mutex> lock(mumps);
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
   const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
   outcome.iterations = Ipopt::IsValid(statistics) ? statistics->IterationCount() : 0;

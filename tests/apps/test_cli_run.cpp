@@ -342,6 +342,22 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
     CHECK(contactShare > 1.0);  // the second sole does carry load: the check is not Γ0 against Γ0
     CHECK(worst <= 1e-9 * largest);
   }
+  // Every inner solver in the bilevel formulation, samples solved on two threads: Ipopt's
+  // inner solves share MUMPS, which is not thread-safe (they crashed before being serialised).
+  for (const char* solver : {"slsqp", "ipopt"}) {
+    const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
+      root["samples"] = 16;
+      root["hessian"] = "limited-memory";
+      root["inner"]["solver"] = solver;
+    }, std::string("weight_shift_") + solver + ".yaml");
+    const auto out = dir.path() / solver;
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 3",
+                                  "OMP_NUM_THREADS=2");
+    INFO(solver << ": " << r.all());
+    CHECK(r.exitCode == 4);
+    CHECK_THAT(r.output, Contains("(inner solver " + std::string(solver) + ")"));
+    CHECK(readJson(out / "result.json")["history"].size() == 4);
+  }
   // Bad contact wrench files name the file and the field.
   const auto bad = dir.write("bad_wrenches.json", "{\"contact_surfaces\": \"" +
                                                      (test::sourceDir() / "robots/hrp2/contacts.yaml").string() +

@@ -19,11 +19,13 @@ struct CommandResult {
   std::string all() const { return output + errors; }
 };
 
-inline CommandResult runMcopt(const std::string& arguments) {
+/// environment: assignments placed before the command, e.g. "OMP_NUM_THREADS=2".
+inline CommandResult runMcopt(const std::string& arguments, const std::string& environment = "") {
   std::string errorFile = (std::filesystem::temp_directory_path() / "mcopt-stderr-XXXXXX").string();
   const int fd = ::mkstemp(errorFile.data());
   if (fd >= 0) ::close(fd);
-  const std::string command = std::string(MCOPT_EXECUTABLE) + " " + arguments + " 2>'" + errorFile + "'";
+  const std::string command = (environment.empty() ? "" : environment + " ") + std::string(MCOPT_EXECUTABLE) + " " +
+                              arguments + " 2>'" + errorFile + "'";
   CommandResult result;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) return result;
