@@ -9,6 +9,7 @@
 #include <IpTNLPAdapter.hpp>
 
 #include <chrono>
+#include <iterator>
 
 #include "core/errors.hpp"
 
@@ -19,27 +20,51 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
-/// Ipopt's outcome as ours, with its own words.
-std::pair<OuterStatus, std::string> describe(Ipopt::SolverReturn status) {
+/// Each OuterStatus's name in result.json and Ipopt's words for it, in the enum's order:
+/// the one place the statuses are listed.
+struct StatusText {
+  const char* name;
+  const char* message;
+};
+constexpr StatusText kStatusText[] = {
+    {"running", "Ipopt was running"},
+    {"optimal", "Optimal Solution Found"},
+    {"acceptable", "Solved To Acceptable Level"},
+    {"maximum_iterations", "Maximum Number of Iterations Exceeded"},
+    {"maximum_cpu_time", "Maximum CPU time exceeded"},
+    {"tiny_step", "Search Direction is becoming Too Small"},
+    {"infeasible", "Converged to a point of local infeasibility"},
+    {"interrupted", "Stopping optimization at current point as requested by user"},
+    {"feasible_point_found", "Feasible point for square problem found"},
+    {"diverging", "Iterates diverging; problem might be unbounded"},
+    {"restoration_failed", "Restoration Phase Failed"},
+    {"error_in_step_computation", "Error in step computation"},
+    {"invalid_number", "Invalid number in NLP function or derivative detected"},
+    {"too_few_degrees_of_freedom", "Problem has too few degrees of freedom"},
+    {"invalid_option", "Invalid option"},
+    {"out_of_memory", "Not enough memory"},
+    {"internal_error", "Internal error"},
+};
+static_assert(std::size(kStatusText) == static_cast<std::size_t>(OuterStatus::InternalError) + 1);
+
+OuterStatus fromIpopt(Ipopt::SolverReturn status) {
   switch (status) {
-    case Ipopt::SUCCESS: return {OuterStatus::Optimal, "Optimal Solution Found"};
-    case Ipopt::MAXITER_EXCEEDED: return {OuterStatus::MaximumIterations, "Maximum Number of Iterations Exceeded"};
-    case Ipopt::CPUTIME_EXCEEDED: return {OuterStatus::MaximumCpuTime, "Maximum CPU time exceeded"};
-    case Ipopt::STOP_AT_TINY_STEP: return {OuterStatus::TinyStep, "Search Direction is becoming Too Small"};
-    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return {OuterStatus::Acceptable, "Solved To Acceptable Level"};
-    case Ipopt::LOCAL_INFEASIBILITY: return {OuterStatus::Infeasible, "Converged to a point of local infeasibility"};
-    case Ipopt::USER_REQUESTED_STOP:
-      return {OuterStatus::Interrupted, "Stopping optimization at current point as requested by user"};
-    case Ipopt::FEASIBLE_POINT_FOUND: return {OuterStatus::FeasiblePointFound, "Feasible point for square problem found"};
-    case Ipopt::DIVERGING_ITERATES: return {OuterStatus::Diverging, "Iterates diverging; problem might be unbounded"};
-    case Ipopt::RESTORATION_FAILURE: return {OuterStatus::RestorationFailed, "Restoration Phase Failed"};
-    case Ipopt::ERROR_IN_STEP_COMPUTATION: return {OuterStatus::ErrorInStepComputation, "Error in step computation"};
-    case Ipopt::INVALID_NUMBER_DETECTED:
-      return {OuterStatus::InvalidNumber, "Invalid number in NLP function or derivative detected"};
-    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return {OuterStatus::TooFewDegreesOfFreedom, "Problem has too few degrees of freedom"};
-    case Ipopt::INVALID_OPTION: return {OuterStatus::InvalidOption, "Invalid option"};
-    case Ipopt::OUT_OF_MEMORY: return {OuterStatus::OutOfMemory, "Not enough memory"};
-    default: return {OuterStatus::InternalError, "Internal error"};
+    case Ipopt::SUCCESS: return OuterStatus::Optimal;
+    case Ipopt::MAXITER_EXCEEDED: return OuterStatus::MaximumIterations;
+    case Ipopt::CPUTIME_EXCEEDED: return OuterStatus::MaximumCpuTime;
+    case Ipopt::STOP_AT_TINY_STEP: return OuterStatus::TinyStep;
+    case Ipopt::STOP_AT_ACCEPTABLE_POINT: return OuterStatus::Acceptable;
+    case Ipopt::LOCAL_INFEASIBILITY: return OuterStatus::Infeasible;
+    case Ipopt::USER_REQUESTED_STOP: return OuterStatus::Interrupted;
+    case Ipopt::FEASIBLE_POINT_FOUND: return OuterStatus::FeasiblePointFound;
+    case Ipopt::DIVERGING_ITERATES: return OuterStatus::Diverging;
+    case Ipopt::RESTORATION_FAILURE: return OuterStatus::RestorationFailed;
+    case Ipopt::ERROR_IN_STEP_COMPUTATION: return OuterStatus::ErrorInStepComputation;
+    case Ipopt::INVALID_NUMBER_DETECTED: return OuterStatus::InvalidNumber;
+    case Ipopt::TOO_FEW_DEGREES_OF_FREEDOM: return OuterStatus::TooFewDegreesOfFreedom;
+    case Ipopt::INVALID_OPTION: return OuterStatus::InvalidOption;
+    case Ipopt::OUT_OF_MEMORY: return OuterStatus::OutOfMemory;
+    default: return OuterStatus::InternalError;
   }
 }
 
@@ -154,7 +179,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
   void finalize_solution(Ipopt::SolverReturn status, Index n, const Number* x, const Number*, const Number*, Index,
                          const Number*, const Number*, Number objective, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
-    std::tie(outcome_.status, outcome_.message) = describe(status);
+    outcome_.status = fromIpopt(status);
+    outcome_.message = kStatusText[static_cast<std::size_t>(outcome_.status)].message;
     finalized_ = true;
     outcome_.objective = objective;
     if (x != nullptr) outcome_.x = copy(x, n);
@@ -223,28 +249,7 @@ void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
 
 }  // namespace
 
-const char* toString(OuterStatus status) {
-  switch (status) {
-    case OuterStatus::Running: return "running";
-    case OuterStatus::Optimal: return "optimal";
-    case OuterStatus::Acceptable: return "acceptable";
-    case OuterStatus::MaximumIterations: return "maximum_iterations";
-    case OuterStatus::MaximumCpuTime: return "maximum_cpu_time";
-    case OuterStatus::TinyStep: return "tiny_step";
-    case OuterStatus::Infeasible: return "infeasible";
-    case OuterStatus::Interrupted: return "interrupted";
-    case OuterStatus::FeasiblePointFound: return "feasible_point_found";
-    case OuterStatus::Diverging: return "diverging";
-    case OuterStatus::RestorationFailed: return "restoration_failed";
-    case OuterStatus::ErrorInStepComputation: return "error_in_step_computation";
-    case OuterStatus::InvalidNumber: return "invalid_number";
-    case OuterStatus::TooFewDegreesOfFreedom: return "too_few_degrees_of_freedom";
-    case OuterStatus::InvalidOption: return "invalid_option";
-    case OuterStatus::OutOfMemory: return "out_of_memory";
-    case OuterStatus::InternalError: return "internal_error";
-  }
-  return "internal_error";
-}
+const char* toString(OuterStatus status) { return kStatusText[static_cast<std::size_t>(status)].name; }
 
 IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, const IpoptSettings& settings,
                             const std::function<bool(const IterationReport&)>& onIteration) {
