@@ -128,15 +128,9 @@ MotionProblem::MotionProblem(const Scenario& scenario)
   slackStart_ = forceStart_ + forceVariableCount();
   variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * scenario_.samples : 0);
   if (bilevel_) {
-    const std::vector<double> u = sampleTimes(scenario_.samples);
-    for (int s = 0; s < scenario_.samples; ++s) {
-      std::vector<ContactSurface> active{scenario_.support};
-      for (int i = 0; i < contacts; ++i)
-        if (insideWindow(u[static_cast<std::size_t>(s)], windows_[static_cast<std::size_t>(i)]))
-          active.push_back(scenario_.contacts[static_cast<std::size_t>(i)].surface);
-      bilevelSamples_.push_back(
-          std::make_unique<BilevelSample>(model_, active, scenario_.inner, scenario_.sensitivity, weight_));
-    }
+    for (int s = 0; s < scenario_.samples; ++s)
+      bilevelSamples_.push_back(std::make_unique<BilevelSample>(model_, surfacesInContact(s), scenario_.inner,
+                                                                scenario_.sensitivity, weight_));
   }
 
   for (int j = 0; j < jointCount_; ++j)
@@ -206,6 +200,13 @@ MotionProblem::~MotionProblem() = default;
 
 bool MotionProblem::contactActive(int contact, int sample) const {
   return insideWindow(static_cast<double>(sample) / (samples_.sampleCount() - 1), windows_[static_cast<std::size_t>(contact)]);
+}
+
+std::vector<ContactSurface> MotionProblem::surfacesInContact(int sample) const {
+  std::vector<ContactSurface> surfaces{scenario_.support};
+  for (int i = 0; i < outputs_.contacts; ++i)
+    if (contactActive(i, sample)) surfaces.push_back(scenario_.contacts[static_cast<std::size_t>(i)].surface);
+  return surfaces;
 }
 
 MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
@@ -386,20 +387,19 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
   if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
     // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).
-    const std::vector<double> u = sampleTimes(scenario_.samples);
     std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, scenario_.samples));
     ThreadWorkspace& w = workspaces_.front();
     Eigen::MatrixXd controlPoints;
     parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
     std::unique_ptr<BilevelSample> previous;
     for (int s = 0; s < scenario_.samples; ++s) {
-      std::vector<ContactSurface> active{scenario_.support};
       std::vector<int> which;
       for (int i = 0; i < outputs_.contacts; ++i)
-        if (contactActive(i, s)) active.push_back(scenario_.contacts[static_cast<std::size_t>(i)].surface), which.push_back(i);
+        if (contactActive(i, s)) which.push_back(i);
       samples_.evaluate(s, controlPoints, duration(x), w.q, w.v, w.a);
       inverseDynamics(model_, w.data, w.q, w.v, w.a);
-      auto sample = std::make_unique<BilevelSample>(model_, active, scenario_.inner, scenario_.sensitivity, weight_);
+      auto sample =
+          std::make_unique<BilevelSample>(model_, surfacesInContact(s), scenario_.inner, scenario_.sensitivity, weight_);
       if (previous) sample->warmStartFrom(*previous);
       sample->evaluate(model_, w.data, nullptr, scenario_.actuators, w.v, w.a, false);
       for (std::size_t k = 0; k < which.size(); ++k)

@@ -195,6 +195,8 @@ class MotionProblem final : public NlpProblem {
   void evaluateTaskInstant(int i, double duration, bool derivatives, ThreadWorkspace& w);
   void buildStructure();
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
+  /// The reference surface, then the environment contacts in contact at the sample (their order).
+  std::vector<ContactSurface> surfacesInContact(int sample) const;
   int slackIndex(int sample, int joint) const { return slackStart_ + sample * jointCount_ + joint; }
 
   const Scenario& scenario_;
