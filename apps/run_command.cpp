@@ -134,14 +134,12 @@ int runMotion(const RunOptions& o) {
   record.configurationSeconds = seconds(configurationClock);
 
   const Eigen::VectorXd x0 = problem.initialPoint(start, end);
-  std::cout << "motion optimisation (Ipopt, "
-            << (scenario.finiteDifferenceHessian ? "Hessian by differences of exact gradients" : "limited-memory Hessian")
-            << ")\n"
+  std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian) << ")\n"
             << "   iter      energy [J]   violation   dual inf.     elapsed" << (problem.bilevel() ? "   infeasible samples" : "")
             << "\n";
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
-  settings.finiteDifferenceHessian = scenario.finiteDifferenceHessian;
+  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
   const auto optimisationClock = std::chrono::steady_clock::now();
   double lastCheckpoint = 0.0;
   record.solver = solveWithIpopt(problem, x0, settings, [&](const IterationReport& r) {
@@ -150,7 +148,8 @@ int runMotion(const RunOptions& o) {
     const MotionProblem::InnerStatistics inner = problem.innerStatistics();
     if (problem.bilevel()) std::printf("   %d", inner.infeasible);
     std::printf("\n");
-    record.history.push_back({r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds, inner});
+    record.history.push_back({r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds, r.stepSize,
+                              r.regularisation, r.barrier, r.timings, inner});
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
         r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {

@@ -125,13 +125,27 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
                       {"constraints", problem.constraintCount()},
                       {"jacobian_nonzeros", problem.jacobianNonZeros()}};
   if (!record.solver.evaluationError.empty()) result["solver"]["evaluation_error"] = record.solver.evaluationError;
+  result["solver"]["hessian"] = toString(scenario.hessian);
+  // Where the time went: per iteration (since the previous one) and for the whole solve.
+  auto split = [](const SolveTimings& now, const SolveTimings& before) {
+    return Json{{"functions", now.functions - before.functions},
+                {"gradient_and_jacobian", now.derivatives - before.derivatives},
+                {"hessian", now.hessian - before.hessian},
+                {"ipopt", now.ipopt() - before.ipopt()}};
+  };
   Json history = Json::array();
+  SolveTimings previous;
   for (const IterationRecord& h : record.history) {
     Json line = {{"iteration", h.iteration},
                  {"objective", h.objective},
                  {"violation", h.violation},
                  {"dual_infeasibility", h.dualInfeasibility},
-                 {"elapsed_seconds", h.elapsedSeconds}};
+                 {"step_size", h.stepSize},
+                 {"regularisation", h.regularisation},
+                 {"barrier", h.barrier},
+                 {"elapsed_seconds", h.elapsedSeconds},
+                 {"seconds", split(h.timings, previous)}};
+    previous = h.timings;
     if (problem.bilevel())
       line["inner"] = {{"optimal", h.inner.optimal},
                        {"infeasible", h.inner.infeasible},
@@ -144,7 +158,8 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},
-                       {"total_seconds", record.totalSeconds}};
+                       {"total_seconds", record.totalSeconds},
+                       {"optimisation_split", split(record.solver.timings, SolveTimings{})}};
 
   // The states as a `mcopt dynamics` input: re-evaluating them reproduces `torques`.
   Json states;

@@ -27,6 +27,8 @@ struct PostureOutcome {
 struct IterationRecord {
   int iteration = 0;
   double objective = 0.0, violation = 0.0, dualInfeasibility = 0.0, elapsedSeconds = 0.0;
+  double stepSize = 0.0, regularisation = 0.0, barrier = 0.0;  ///< Ipopt's α_pr, δ_w and μ
+  SolveTimings timings;  ///< cumulative up to this iteration
   MotionProblem::InnerStatistics inner;
 };
 

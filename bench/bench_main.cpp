@@ -9,6 +9,7 @@ void registerDynamicsBenchmarks();
 void registerInnerBenchmarks();
 void registerSensitivityBenchmarks();
 void registerOptimisationBenchmarks();
+void registerOuterHessianBenchmarks();
 }
 
 int main(int argc, char** argv) {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   mcopt::bench::registerInnerBenchmarks();
   mcopt::bench::registerSensitivityBenchmarks();
   mcopt::bench::registerOptimisationBenchmarks();
+  mcopt::bench::registerOuterHessianBenchmarks();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::RunSpecifiedBenchmarks();

@@ -26,7 +26,7 @@ void optimisation(benchmark::State& state, const std::string& file, ContactForce
   scenario.solverOptions.push_back(limit);
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
-  settings.finiteDifferenceHessian = scenario.finiteDifferenceHessian;
+  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
   IpoptOutcome outcome;
   double violation = 0.0, seconds = 0.0;
   for (auto _ : state) {

@@ -68,6 +68,19 @@ OuterStatus fromIpopt(Ipopt::SolverReturn status) {
   }
 }
 
+/// Adds the time of its scope to a counter.
+class Clock {
+ public:
+  explicit Clock(double& seconds) : seconds_(seconds), start_(std::chrono::steady_clock::now()) {}
+  ~Clock() { seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
+  Clock(const Clock&) = delete;
+  Clock& operator=(const Clock&) = delete;
+
+ private:
+  double& seconds_;
+  std::chrono::steady_clock::time_point start_;
+};
+
 class ProblemTnlp final : public Ipopt::TNLP {
  public:
   ProblemTnlp(NlpProblem& problem, const Eigen::VectorXd& start, IpoptOutcome& outcome,
@@ -105,12 +118,14 @@ class ProblemTnlp final : public Ipopt::TNLP {
   bool eval_f(Index n, const Number* x, bool, Number& value) override {
     return guarded([&] {
       ++outcome_.objectiveEvaluations;
+      const Clock clock(outcome_.timings.functions);
       value = problem_.objective(copy(x, n));
     });
   }
   bool eval_grad_f(Index n, const Number* x, bool, Number* gradient) override {
     return guarded([&] {
       ++outcome_.gradientEvaluations;
+      const Clock clock(outcome_.timings.derivatives);
       problem_.objectiveGradient(copy(x, n), buffer_);
       Eigen::Map<Eigen::VectorXd>(gradient, n) = buffer_;
     });
@@ -118,6 +133,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
   bool eval_g(Index n, const Number* x, bool, Index m, Number* g) override {
     return guarded([&] {
       ++outcome_.constraintEvaluations;
+      const Clock clock(outcome_.timings.functions);
       problem_.constraints(copy(x, n), buffer_);
       Eigen::Map<Eigen::VectorXd>(g, m) = buffer_;
     });
@@ -129,6 +145,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
     }
     return guarded([&] {
       ++outcome_.jacobianEvaluations;
+      const Clock clock(outcome_.timings.derivatives);
       problem_.jacobianValues(copy(x, n), buffer_);
       Eigen::Map<Eigen::VectorXd>(values, nnz) = buffer_;
     });
@@ -143,34 +160,25 @@ class ProblemTnlp final : public Ipopt::TNLP {
       return true;
     }
     return guarded([&] {
-      // Column c = (∇L(x + h e_c) − ∇L(x)) / h, ∇L = σ ∇f + Jᵀ λ, then symmetrised. Forward
-      // differences: half the evaluations of central ones, and Newton's steps do not need
-      // more than their ~1e-6 relative accuracy (h = 1e-6 balances truncation and round-off).
-      const Eigen::Map<const Eigen::VectorXd> multipliers(lambda, m);
-      Eigen::VectorXd point = copy(x, n), base, plus;
-      lagrangianGradient(point, objectiveFactor, multipliers, base);
-      Eigen::MatrixXd columns(curved, curved);
-      for (Index c = 0; c < curved; ++c) {
-        const double saved = point[c], h = 1e-6 * std::max(1.0, std::abs(saved));
-        point[c] = saved + h;
-        lagrangianGradient(point, objectiveFactor, multipliers, plus);
-        point[c] = saved;
-        columns.col(c) = (plus - base).head(curved) / h;
-      }
-      Index k = 0;
-      for (Index r = 0; r < curved; ++r)
-        for (Index c = 0; c <= r; ++c) values[k++] = 0.5 * (columns(r, c) + columns(c, r));
+      const Clock clock(outcome_.timings.hessian);
+      problem_.lagrangianHessian(copy(x, n), objectiveFactor, Eigen::Map<const Eigen::VectorXd>(lambda, m), buffer_);
+      Eigen::Map<Eigen::VectorXd>(values, buffer_.size()) = buffer_;
     });
   }
   bool intermediate_callback(Ipopt::AlgorithmMode mode, Index iteration, Number objective, Number primal, Number dual,
-                             Number, Number, Number, Number, Number, Index, const Ipopt::IpoptData* data,
-                             Ipopt::IpoptCalculatedQuantities* quantities) override {
+                             Number barrier, Number, Number regularisation, Number, Number primalStep, Index,
+                             const Ipopt::IpoptData* data, Ipopt::IpoptCalculatedQuantities* quantities) override {
     IterationReport r;
     r.iteration = iteration;
     r.objective = objective;
     r.violation = primal;
     r.dualInfeasibility = dual;
+    r.barrier = barrier;
+    r.regularisation = regularisation;
+    r.stepSize = primalStep;
     r.elapsedSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_).count();
+    outcome_.timings.total = r.elapsedSeconds;
+    r.timings = outcome_.timings;
     if (mode == Ipopt::RegularMode && currentIterate(data, quantities)) r.iterate = &iterate_;
     outcome_.iterations = iteration;
     r.progress = &outcome_;
@@ -187,15 +195,6 @@ class ProblemTnlp final : public Ipopt::TNLP {
   }
 
  private:
-  void lagrangianGradient(const Eigen::VectorXd& x, double objectiveFactor, const Eigen::Ref<const Eigen::VectorXd>& lambda,
-                          Eigen::VectorXd& out) {
-    problem_.objectiveGradient(x, out);
-    out *= objectiveFactor;
-    problem_.jacobianValues(x, jacobian_);
-    const Eigen::VectorXi& rows = problem_.jacobianRows();
-    const Eigen::VectorXi& cols = problem_.jacobianColumns();
-    for (Eigen::Index k = 0; k < jacobian_.size(); ++k) out[cols[k]] += jacobian_[k] * lambda[rows[k]];
-  }
   /// Ipopt 3.11 hands the callback its internal iterate only: undo the variable scaling and
   /// put back the variables it fixed (the TNLP adapter's own mapping) to get our x.
   bool currentIterate(const Ipopt::IpoptData* data, Ipopt::IpoptCalculatedQuantities* quantities) {
@@ -228,7 +227,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
   const std::function<bool(const IterationReport&)>& onIteration_;
   std::chrono::steady_clock::time_point clock_;
   bool hessian_;
-  Eigen::VectorXd jacobian_, iterate_;
+  Eigen::VectorXd iterate_;
   bool finalized_ = false;
 };
 
@@ -258,8 +257,7 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
   // Ours first (formulation.md §10); the scenario's options override them.
   app->Options()->SetIntegerValue("print_level", settings.printLevel);
   app->Options()->SetStringValue("sb", "yes");
-  app->Options()->SetStringValue("hessian_approximation",
-                                 settings.finiteDifferenceHessian ? "exact" : "limited-memory");
+  app->Options()->SetStringValue("hessian_approximation", settings.problemHessian ? "exact" : "limited-memory");
   app->Options()->SetNumericValue("tol", 1e-6);
   app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
   app->Options()->SetIntegerValue("max_iter", 3000);
@@ -271,10 +269,11 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
 
   IpoptOutcome outcome;
   const auto clock = std::chrono::steady_clock::now();
-  auto* adapter = new ProblemTnlp(problem, start, outcome, onIteration, settings.finiteDifferenceHessian);
+  auto* adapter = new ProblemTnlp(problem, start, outcome, onIteration, settings.problemHessian);
   Ipopt::SmartPtr<Ipopt::TNLP> tnlp = adapter;  // owns it
   const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
+  outcome.timings.total = outcome.seconds;
   const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
   if (Ipopt::IsValid(statistics)) outcome.iterations = statistics->IterationCount();
   if (!adapter->finalized()) {

@@ -26,12 +26,25 @@ const char* toString(OuterStatus status);
 
 struct IpoptOutcome;
 
+/// Where an optimisation's time went, cumulative [s]: our callbacks (values of f and g;
+/// gradient and Jacobian; Hessian) and the total since Ipopt started. The rest,
+/// total − functions − derivatives − hessian, is Ipopt's own work: the KKT factorisations
+/// and solves (MUMPS), line search and convergence tests.
+struct SolveTimings {
+  double functions = 0.0, derivatives = 0.0, hessian = 0.0, total = 0.0;
+  double ipopt() const { return total - functions - derivatives - hessian; }
+};
+
 struct IterationReport {
   int iteration = 0;
   double objective = 0.0;
   double violation = 0.0;      ///< Ipopt's primal infeasibility (of the scaled problem's unscaled rows)
   double dualInfeasibility = 0.0;
   double elapsedSeconds = 0.0;
+  double barrier = 0.0;         ///< Ipopt's barrier parameter μ
+  double regularisation = 0.0;  ///< δ added to the Hessian's diagonal for the inertia (0: none)
+  double stepSize = 0.0;        ///< α of the primal step that led here
+  SolveTimings timings;         ///< cumulative, up to this iteration
   /// The current iterate in the problem's variables; null in Ipopt's restoration phase,
   /// whose iterates belong to another problem.
   const Eigen::VectorXd* iterate = nullptr;
@@ -47,15 +60,16 @@ struct IpoptOutcome {
   int iterations = 0;
   int objectiveEvaluations = 0, gradientEvaluations = 0, constraintEvaluations = 0, jacobianEvaluations = 0;
   double seconds = 0.0;
+  SolveTimings timings;
   std::string evaluationError; ///< the first exception a callback raised, if any
 };
 
 struct IpoptSettings {
   std::vector<SolverOption> options;   ///< applied after ours, in order
   int printLevel = 0;                  ///< Ipopt's console output (ours is the progress line)
-  /// Give Ipopt the Lagrangian's Hessian by forward differences of the exact gradients
-  /// (dense over the nonlinear variables) instead of its limited-memory approximation.
-  bool finiteDifferenceHessian = false;
+  /// Give Ipopt the Lagrangian's Hessian from NlpProblem::lagrangianHessian (dense over the
+  /// nonlinear variables) instead of its limited-memory approximation.
+  bool problemHessian = false;
 };
 
 /// Returns false from `onIteration` to stop (Ipopt then reports "interrupted").

@@ -11,6 +11,7 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/motion_workspace.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
@@ -80,27 +81,6 @@ const char* constraintKindName(ConstraintKind kind) {
   }
   return "?";
 }
-
-/// Per-thread buffers, sized once (the per-sample path allocates nothing).
-struct MotionProblem::ThreadWorkspace {
-  ThreadWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
-    const int n = model.jointCount();
-    q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
-    torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
-    toTorque.assign(static_cast<std::size_t>(contacts), WrenchToTorque::Zero(n, 6));
-    toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
-    rowsByWrench.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
-  }
-  DynamicsData data;
-  DynamicsDerivatives derivatives;
-  TaskWorkspace task;
-  Eigen::VectorXd q, v, a, torque;
-  Eigen::MatrixXd torqueDq, dTorque;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> referenceDq, dWorld;
-  std::vector<WrenchToTorque> toTorque;  ///< per environment contact, J1_i
-  std::vector<Matrix6> toWorld;          ///< per environment contact, wrenchToWorld_i
-  std::vector<Matrix6> rowsByWrench;     ///< per environment contact, ∂rows_i/∂F_i
-};
 
 MotionProblem::MotionProblem(const Scenario& scenario)
     : scenario_(scenario),
@@ -419,8 +399,16 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
 
 void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-  const int n = jointCount_, contacts = outputs_.contacts;
   samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+  sampleOutputs(s, x, derivatives, w, b);
+  if (!derivatives) return;
+  samples_.chainRule(s, T, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
+  SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
+}
+
+void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w,
+                                  SampleBlock& b) {
+  const int n = jointCount_, contacts = outputs_.contacts;
   if (derivatives)
     inverseDynamicsDerivatives(model_, w.data, w.derivatives, w.q, w.v, w.a);
   else
@@ -454,6 +442,9 @@ void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bo
     w.torque = w.data.tau;
     Vector6 reference = w.data.referenceWrench;
     if (derivatives) w.torqueDq = d.dtauDq, w.referenceDq = d.dwrenchDq;
+    // A contact's rows depend on its own columns only: the others' entries must read zero
+    // even in a block that served another sample (the Hessian's probes).
+    if (derivatives) b.dyDz.setZero();
     for (int i = 0; i < contacts; ++i) {
       if (!forces_->active(i, s)) continue;
       Vector6 F = Vector6::Zero();
@@ -517,22 +508,23 @@ void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bo
     b.dyDa(row, j) += p.dAcceleration;
     if (b.dyDz.cols() > 0) b.dyDz.row(row) = p.dTorque * b.dyDz.row(outputs_.torque(j));
   }
-  if (!derivatives) return;
-  samples_.chainRule(s, T, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
-  SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
 }
 
 void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
-  const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
   taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+  taskOutputs(i, derivatives, w, b);
+  if (!derivatives) return;
+  taskSamples_.chainRule(i, T, b.dyDq, b.dyDv, Eigen::MatrixXd(), b.dyDx, b.parameters);
+  SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
+}
+
+void MotionProblem::taskOutputs(int i, bool derivatives, ThreadWorkspace& w, SampleBlock& b) {
+  const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
   inverseDynamics(model_, w.data, w.q, w.v, w.a);
   Vector3 value;
   evaluateTask(model_, w.data, task, derivatives, w.task, value, b.dyDq, b.dyDv);
   b.y = value;
-  if (!derivatives) return;
-  taskSamples_.chainRule(i, T, b.dyDq, b.dyDv, Eigen::MatrixXd(), b.dyDx, b.parameters);
-  SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
 }
 
 void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {

@@ -139,6 +139,11 @@ class MotionProblem final : public NlpProblem {
   void objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) override;
   void constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) override;
   void jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& values) override;
+  /// The scenario's `hessian` option: `sample-differences` assembles Σ_s B_sᵀ H_s B_s from
+  /// each sample's and task instant's state-space Hessian (motion_hessian.cpp); otherwise
+  /// the generic differences of whole gradients (NlpProblem).
+  void lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
+                         const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) override;
 
   /// Largest violation of constraint rows and variable bounds, overall and per kind
   /// (variable bounds count as "position limit").
@@ -193,7 +198,24 @@ class MotionProblem final : public NlpProblem {
   void evaluate(const Eigen::VectorXd& x, bool derivatives);
   void evaluateSample(int s, const Eigen::VectorXd& x, double duration, bool derivatives, ThreadWorkspace& w);
   void evaluateTaskInstant(int i, double duration, bool derivatives, ThreadWorkspace& w);
+  /// A sample's outputs (and their derivatives in its state and force columns) at the state
+  /// in w.q, w.v, w.a and the force variables of x, into `b`.
+  void sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w, SampleBlock& b);
+  /// A task instant's outputs at the state in w.q, w.v (w.a for the dynamics' forward pass).
+  void taskOutputs(int i, bool derivatives, ThreadWorkspace& w, SampleBlock& b);
   void buildStructure();
+  /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
+  struct HessianWorkspace {
+    Eigen::VectorXd probeX, weights, base, gradient;
+    Eigen::MatrixXd stateHessian, spread, local, sum;
+    std::vector<int> columns;
+  };
+  void sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,
+                                const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values);
+  /// ∇ of one sample's Lagrangian terms in its state (q, q̇, q̈) and force columns, from the
+  /// outputs' derivatives in `b` and each output's multiplier (+ the objective's share).
+  void sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                double objectiveWeight, HessianWorkspace& h, Eigen::Ref<Eigen::VectorXd> gradient) const;
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;
@@ -227,6 +249,9 @@ class MotionProblem final : public NlpProblem {
 
   std::vector<SampleBlock> blocks_, taskBlocks_;
   std::vector<ThreadWorkspace> workspaces_;
+  std::vector<HessianWorkspace> hessianWorkspaces_;
+  std::vector<SampleBlock> probes_, taskProbes_;  ///< per thread: outputs at a perturbed state
+  Eigen::MatrixXd sampleMultipliers_, taskMultipliers_;  ///< per output × sample / task instant
   Eigen::MatrixXd controlPoints_;
   Eigen::VectorXd cachedX_;
   bool cachedDerivatives_ = false, cacheValid_ = false;

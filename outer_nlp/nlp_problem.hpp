@@ -27,6 +27,22 @@ class NlpProblem {
   virtual int nonlinearVariableCount() const { return variableCount(); }
   /// A readable name of constraint row `row`, for messages.
   virtual std::string rowName(int row) const = 0;
+
+  /// The Lagrangian's Hessian σ ∇²f + Σ λ_i ∇²g_i over the nonlinear variables, as the dense
+  /// lower triangle row by row ((0,0), (1,0), (1,1), (2,0) …; `values` resized). This
+  /// generic version takes forward differences of the exact gradients, one evaluation per
+  /// nonlinear variable; a problem that knows its structure overrides it.
+  virtual void lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
+                                 const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values);
+  /// ∇L = σ ∇f + Jᵀ λ (all variables).
+  void lagrangianGradient(const Eigen::VectorXd& x, double objectiveFactor,
+                          const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& gradient);
+
+ private:
+  Eigen::VectorXd jacobianScratch_;
 };
+
+/// Index of entry (row, column), column ≤ row, in a dense lower triangle stored row by row.
+inline Eigen::Index lowerTriangleIndex(Eigen::Index row, Eigen::Index column) { return row * (row + 1) / 2 + column; }
 
 }  // namespace mcopt

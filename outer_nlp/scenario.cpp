@@ -326,6 +326,28 @@ ContactForces parseContactForces(const std::string& name) {
   throw InputError("unknown contact-force formulation '" + name + "' (expected bilevel, splines or variables)");
 }
 
+namespace {
+struct HessianName {
+  HessianOption option;
+  const char* name;
+};
+constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited-memory"},
+                                         {HessianOption::FiniteDifferences, "finite-differences"},
+                                         {HessianOption::SampleDifferences, "sample-differences"}};
+}  // namespace
+
+const char* toString(HessianOption hessian) {
+  for (const HessianName& h : kHessianNames)
+    if (h.option == hessian) return h.name;
+  return "?";
+}
+
+HessianOption parseHessianOption(const std::string& name) {
+  for (const HessianName& h : kHessianNames)
+    if (name == h.name) return h.option;
+  throw InputError("expected limited-memory, finite-differences or sample-differences, got '" + name + "'");
+}
+
 Scenario loadScenario(const std::filesystem::path& file) {
   const YAML::Node root = yaml::loadFile(file);
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
@@ -466,11 +488,13 @@ Scenario loadScenario(const std::filesystem::path& file) {
   }
   if (root["hessian"]) {
     const std::string hessian = yaml::text(file, root["hessian"], "hessian");
-    if (hessian != "limited-memory" && hessian != "finite-differences")
-      throw InputError(where(file, root["hessian"], "hessian") + "expected limited-memory or finite-differences, got '" +
-                       hessian + "'");
-    s.finiteDifferenceHessian = hessian == "finite-differences";
+    try {
+      s.hessian = parseHessianOption(hessian);
+    } catch (const InputError& e) {
+      throw InputError(where(file, root["hessian"], "hessian") + e.what());
+    }
   }
+
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   return s;
 }

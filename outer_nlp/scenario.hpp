@@ -51,6 +51,17 @@ const char* toString(ContactForces forces);
 /// "bilevel", "splines" or "variables"; throws InputError otherwise (the message lists them).
 ContactForces parseContactForces(const std::string& name);
 
+/// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/scenarios.md, "Hessian
+/// and convergence").
+enum class HessianOption {
+  LimitedMemory,      ///< Ipopt's quasi-Newton (L-BFGS) approximation, as the report
+  FiniteDifferences,  ///< forward differences of the exact gradient, one whole evaluation per variable
+  SampleDifferences,  ///< Σ_s B_sᵀ H_s B_s, H_s by differences of each sample's exact gradient in its state
+};
+const char* toString(HessianOption hessian);
+/// "limited-memory", "finite-differences" or "sample-differences"; throws InputError otherwise.
+HessianOption parseHessianOption(const std::string& name);
+
 /// A contact other than the reference body's: its surface is fixed in the world over the
 /// whole motion or over a window, at a given world pose or the one it has in the start
 /// posture (formulation.md §10).
@@ -118,7 +129,7 @@ struct Scenario {
   int configurationIterations = 500;
 
   std::vector<SolverOption> solverOptions;
-  bool finiteDifferenceHessian = false;  ///< hessian: finite-differences (else limited-memory)
+  HessianOption hessian = HessianOption::LimitedMemory;
 };
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws

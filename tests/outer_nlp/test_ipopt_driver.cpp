@@ -90,7 +90,7 @@ TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", 
   DiscRosenbrock problem;
   const Eigen::VectorXd start = (Eigen::VectorXd(2) << -0.5, 0.2).finished();
   IpoptSettings limitedMemory, differences;
-  differences.finiteDifferenceHessian = true;
+  differences.problemHessian = true;
   const IpoptOutcome quasiNewton = solveWithIpopt(problem, start, limitedMemory, nullptr);
   const IpoptOutcome newton = solveWithIpopt(problem, start, differences, nullptr);
   for (const IpoptOutcome* o : {&quasiNewton, &newton}) {
@@ -107,7 +107,7 @@ TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-differe
   DiscRosenbrock problem;
   const test::TempDir dir;
   IpoptSettings settings;
-  settings.finiteDifferenceHessian = true;
+  settings.problemHessian = true;
   auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
     SolverOption o;
     o.name = name, o.text = text, o.type = type, o.origin = std::string(name) + ": ";
@@ -147,7 +147,7 @@ TEST_CASE("Ipopt driver: every iteration reports its iterate in the problem's va
   const Eigen::VectorXd start = (Eigen::VectorXd(3) << 0.25, -0.5, 0.2).finished();
   for (const bool newton : {false, true}) {
     IpoptSettings settings;
-    settings.finiteDifferenceHessian = newton;
+    settings.problemHessian = newton;
     int reported = 0;
     Eigen::VectorXd last;
     const IpoptOutcome o = solveWithIpopt(problem, start, settings, [&](const IterationReport& r) {

@@ -1,0 +1,215 @@
+// The Lagrangian's Hessian of the motion problem by per-sample differences (formulation.md
+// §10; docs/scenarios.md, "Hessian and convergence").
+//
+// At a fixed duration, every sample row and the objective's share of sample s depend on the
+// spline parameters only through that sample's state z_s = (q, q̇, q̈) — linearly, z_s = B_s x
+// — and on the sample's own force columns (splines, variables). So
+//   ∇²L = Σ_s B_sᵀ H_s B_s + Σ_tasks B_tᵀ H_t B_t (+ the duration's row and column),
+// with H_s the Hessian in z_s of that sample's terms Σ_o λ_o y_o + c_s σ_f Σ_j P⁺(P_j).
+// H_s comes from forward differences of the sample's exact gradient in z_s: 3n (+ force
+// columns) evaluations of one sample's derivatives, where differencing the whole gradient
+// costs one whole-trajectory evaluation per spline parameter. Samples are independent, so
+// they run in parallel. The duration's column (when it is free) is a forward difference of
+// the whole gradient: T scales every sample's velocity and acceleration and the trapezoid
+// weights.
+#include <omp.h>
+
+#include <cmath>
+
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/motion_workspace.hpp"
+#include "sensitivity/bilevel_sample.hpp"
+
+namespace mcopt {
+
+namespace {
+
+/// P⁺ ≈ (P + sqrt(P² + ε²)) / 2: its slope (formulation.md §6).
+inline double smoothMaximumSlope(double p, double epsilon) { return 0.5 * (1.0 + p / std::sqrt(p * p + epsilon * epsilon)); }
+
+/// Forward-difference step for a variable of magnitude `value` (as the generic differences).
+inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }
+
+}  // namespace
+
+void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
+                                      const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
+  if (scenario_.hessian == HessianOption::SampleDifferences)
+    sampleDifferencesHessian(x, objectiveFactor, multipliers, values);
+  else
+    NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
+}
+
+void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                             double objectiveWeight, HessianWorkspace& h,
+                                             Eigen::Ref<Eigen::VectorXd> gradient) const {
+  const int n = jointCount_;
+  h.weights = multipliers;
+  if (scenario_.energyForm == EnergyForm::SmoothMaximum)
+    for (int j = 0; j < n; ++j)
+      h.weights[outputs_.power(j)] += objectiveWeight * smoothMaximumSlope(b.y[outputs_.power(j)], scenario_.smoothing);
+  gradient.segment(0, n).noalias() = b.dyDq.transpose() * h.weights;
+  gradient.segment(n, n).noalias() = b.dyDv.transpose() * h.weights;
+  gradient.segment(2 * n, n).noalias() = b.dyDa.transpose() * h.weights;
+  // The regularisation w Σ q̈² (formulation.md §10).
+  gradient.segment(2 * n, n) += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration;
+  const Eigen::Index forces = gradient.size() - 3 * n;
+  if (forces > 0) gradient.tail(forces).noalias() = b.dyDz.leftCols(forces).transpose() * h.weights;
+}
+
+void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,
+                                             const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                             Eigen::VectorXd& values) {
+  evaluate(x, true);
+  const int n = jointCount_, curved = nonlinearVariableCount(), N = samples_.sampleCount();
+  const double T = duration(x), dt = T / (N - 1);
+
+  // Each row's multiplier on the output it reads (an epigraph row reads −P).
+  sampleMultipliers_.setZero(outputs_.size(), N);
+  taskMultipliers_.setZero(3, static_cast<Eigen::Index>(taskBlocks_.size()));
+  for (std::size_t r = 0; r < rows_.size(); ++r) {
+    const Row& row = rows_[r];
+    const double lambda = multipliers[static_cast<Eigen::Index>(r)];
+    switch (row.kind) {
+      case ConstraintKind::VelocityLimit: break;  // linear in x at a fixed duration
+      case ConstraintKind::Task:
+      case ConstraintKind::Closure: taskMultipliers_(row.output, row.block) += lambda; break;
+      case ConstraintKind::Epigraph: sampleMultipliers_(row.output, row.block) -= lambda; break;
+      default: sampleMultipliers_(row.output, row.block) += lambda; break;
+    }
+  }
+
+  const int threads = static_cast<int>(workspaces_.size());
+  if (hessianWorkspaces_.size() != static_cast<std::size_t>(threads)) {
+    hessianWorkspaces_.assign(static_cast<std::size_t>(threads), HessianWorkspace{});
+    std::size_t forceColumns = 0;
+    for (const SampleBlock& b : blocks_) forceColumns = std::max(forceColumns, b.forceColumns.size());
+    const int outputs = outputs_.size(), contacts = outputs_.contacts;
+    probes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
+    taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
+    for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
+    for (SampleBlock& p : probes_) {
+      p.y.setZero(outputs), p.wrenches.setZero(6 * (1 + contacts)), p.acceleration.setZero(n);
+      p.dyDq.setZero(outputs, n), p.dyDv.setZero(outputs, n), p.dyDa.setZero(outputs, n);
+      p.dyDz.setZero(outputs, static_cast<Eigen::Index>(forceColumns));
+    }
+  }
+
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num();
+    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(t)];
+    HessianWorkspace& h = hessianWorkspaces_[static_cast<std::size_t>(t)];
+    SampleBlock& probe = probes_[static_cast<std::size_t>(t)];
+    SampleBlock& taskProbe = taskProbes_[static_cast<std::size_t>(t)];
+    h.sum.setZero(curved, curved);
+    h.probeX = x;
+
+    // Adds Bᵀ H B to the thread's sum: B maps the local spline parameters (k per joint, their
+    // weights in q, q̇ = (1/T) dq/du, q̈ = (1/T²) d²q/du²) and the force columns to the state.
+    auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
+                      const std::vector<int>& forceColumns) {
+      const int k = weights.count, d = static_cast<int>(h.stateHessian.rows()), nf = static_cast<int>(forceColumns.size());
+      const int local = n * k + nf;
+      const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
+      auto weight = [&](int block, int l) {
+        return scale[block] * (block == 0 ? weights.value[static_cast<std::size_t>(l)]
+                               : block == 1 ? weights.d1[static_cast<std::size_t>(l)]
+                                            : weights.d2[static_cast<std::size_t>(l)]);
+      };
+      h.spread.setZero(d, local);  // H B
+      for (int j = 0; j < n; ++j)
+        for (int l = 0; l < k; ++l)
+          for (int block = 0; block < stateBlocks; ++block)
+            h.spread.col(j * k + l) += weight(block, l) * h.stateHessian.col(block * n + j);
+      for (int f = 0; f < nf; ++f) h.spread.col(n * k + f) = h.stateHessian.col(stateBlocks * n + f);
+      h.local.setZero(local, local);  // Bᵀ H B
+      for (int j = 0; j < n; ++j)
+        for (int l = 0; l < k; ++l)
+          for (int block = 0; block < stateBlocks; ++block)
+            h.local.row(j * k + l) += weight(block, l) * h.spread.row(block * n + j);
+      for (int f = 0; f < nf; ++f) h.local.row(n * k + f) = h.spread.row(stateBlocks * n + f);
+      h.columns.resize(static_cast<std::size_t>(local));
+      for (int c = 0; c < n * k; ++c) h.columns[static_cast<std::size_t>(c)] = parameters[c];
+      for (int f = 0; f < nf; ++f) h.columns[static_cast<std::size_t>(n * k + f)] = forceColumns[static_cast<std::size_t>(f)];
+      for (int r = 0; r < local; ++r)
+        for (int c = 0; c < local; ++c)
+          h.sum(h.columns[static_cast<std::size_t>(r)], h.columns[static_cast<std::size_t>(c)]) += h.local(r, c);
+    };
+
+#pragma omp for schedule(static)
+    for (int s = 0; s < N; ++s) {
+      const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+      const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
+      const double objectiveWeight = objectiveFactor * ((s == 0 || s == N - 1) ? 0.5 * dt : dt);
+      const auto lambda = sampleMultipliers_.col(s);
+      h.base.resize(d), h.gradient.resize(d), h.stateHessian.resize(d, d);
+      sampleLagrangianGradient(b, lambda, objectiveWeight, h, h.base);
+      samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+      for (int c = 0; c < d; ++c) {
+        // Perturb one state component (or force variable), evaluate the sample there.
+        double* component = c < n           ? &w.q[c]
+                            : c < 2 * n     ? &w.v[c - n]
+                            : c < 3 * n     ? &w.a[c - 2 * n]
+                                            : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
+        const double saved = *component, step = differenceStep(saved);
+        *component = saved + step;
+        sampleOutputs(s, h.probeX, true, w, probe);
+        *component = saved;
+        sampleLagrangianGradient(probe, lambda, objectiveWeight, h, h.gradient);
+        h.stateHessian.col(c) = (h.gradient - h.base) / step;
+      }
+      // A bilevel sample keeps its last inner solution (its warm start, its reported status):
+      // leave it at the unperturbed state.
+      if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
+      h.stateHessian = 0.5 * (h.stateHessian + h.stateHessian.transpose()).eval();
+      spread(samples_.weights(s), b.parameters, 3, b.forceColumns);
+    }
+
+#pragma omp for schedule(static)
+    for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
+      const auto lambda = taskMultipliers_.col(i);
+      if ((lambda.array() == 0.0).all()) continue;  // no bounded component
+      const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
+      const int d = 2 * n;  // tasks read positions and velocities
+      h.base.resize(d), h.gradient.resize(d), h.stateHessian.resize(d, d);
+      h.base.head(n).noalias() = b.dyDq.transpose() * lambda;
+      h.base.tail(n).noalias() = b.dyDv.transpose() * lambda;
+      taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+      for (int c = 0; c < d; ++c) {
+        double& component = c < n ? w.q[c] : w.v[c - n];
+        const double saved = component, step = differenceStep(saved);
+        component = saved + step;
+        taskOutputs(i, true, w, taskProbe);
+        component = saved;
+        h.gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
+        h.gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+        h.stateHessian.col(c) = (h.gradient - h.base) / step;
+      }
+      h.stateHessian = 0.5 * (h.stateHessian + h.stateHessian.transpose()).eval();
+      spread(taskSamples_.weights(i), b.parameters, 2, {});
+    }
+  }
+
+  Eigen::MatrixXd& hessian = hessianWorkspaces_.front().sum;
+  for (std::size_t t = 1; t < hessianWorkspaces_.size(); ++t) hessian += hessianWorkspaces_[t].sum;
+
+  if (durationIsFree()) {
+    // The duration's row and column: a forward difference of the whole gradient.
+    const int column = parameterCount_;
+    Eigen::VectorXd base, plus, shifted = x;
+    lagrangianGradient(x, objectiveFactor, multipliers, base);
+    const double step = differenceStep(x[column]);
+    shifted[column] += step;
+    lagrangianGradient(shifted, objectiveFactor, multipliers, plus);
+    const Eigen::VectorXd difference = (plus - base).head(curved) / step;
+    hessian.row(column) = difference.transpose();
+    hessian.col(column) = difference;
+  }
+
+  values.resize(static_cast<Eigen::Index>(curved) * (curved + 1) / 2);
+  for (int r = 0; r < curved; ++r)
+    for (int c = 0; c <= r; ++c) values[lowerTriangleIndex(r, c)] = 0.5 * (hessian(r, c) + hessian(c, r));
+}
+
+}  // namespace mcopt

@@ -1,0 +1,33 @@
+#pragma once
+// MotionProblem's per-thread evaluation buffers, shared by its evaluation
+// (motion_problem.cpp) and its Hessian (motion_hessian.cpp); not part of the interface.
+#include "core/contact_maps.hpp"
+#include "core/dynamics_data.hpp"
+#include "core/dynamics_derivatives.hpp"
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/task_kinematics.hpp"
+
+namespace mcopt {
+
+/// Per-thread buffers, sized once (the per-sample path allocates nothing).
+struct MotionProblem::ThreadWorkspace {
+  ThreadWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
+    const int n = model.jointCount();
+    q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
+    torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
+    toTorque.assign(static_cast<std::size_t>(contacts), WrenchToTorque::Zero(n, 6));
+    toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
+    rowsByWrench.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
+  }
+  DynamicsData data;
+  DynamicsDerivatives derivatives;
+  TaskWorkspace task;
+  Eigen::VectorXd q, v, a, torque;
+  Eigen::MatrixXd torqueDq, dTorque;
+  Eigen::Matrix<double, 6, Eigen::Dynamic> referenceDq, dWorld;
+  std::vector<WrenchToTorque> toTorque;  ///< per environment contact, J1_i
+  std::vector<Matrix6> toWorld;          ///< per environment contact, wrenchToWorld_i
+  std::vector<Matrix6> rowsByWrench;     ///< per environment contact, ∂rows_i/∂F_i
+};
+
+}  // namespace mcopt
