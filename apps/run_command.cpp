@@ -11,9 +11,11 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <memory>
 
 #include "apps/commands.hpp"
 #include "apps/run_output.hpp"
+#include "core/errors.hpp"
 #include "outer_nlp/configuration_problem.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -134,30 +136,63 @@ int runMotion(const RunOptions& o) {
   record.configurationSeconds = seconds(configurationClock);
 
   const Eigen::VectorXd x0 = problem.initialPoint(start, end);
-  std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian) << ")\n"
-            << "   iter      energy [J]   violation   dual inf.     elapsed" << (problem.bilevel() ? "   infeasible samples" : "")
-            << "\n";
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
   const auto optimisationClock = std::chrono::steady_clock::now();
-  double lastCheckpoint = 0.0;
-  record.solver = solveWithIpopt(problem, x0, settings, [&](const IterationReport& r) {
-    std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
-                r.elapsedSeconds);
-    const MotionProblem::InnerStatistics inner = problem.innerStatistics();
-    if (problem.bilevel()) std::printf("   %d", inner.infeasible);
-    std::printf("\n");
-    record.history.push_back({r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds, r.stepSize,
-                              r.regularisation, r.barrier, r.timings, inner});
-    std::fflush(stdout);
-    if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
-        r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
-      writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
-      lastCheckpoint = r.elapsedSeconds;
+  // The continuation's stages (docs/scenarios.md, "Hessian and convergence"), each from the
+  // previous one's iterate, then the scenario's own problem.
+  Eigen::VectorXd x = x0;
+  const std::size_t stages = scenario.continuation.size() + 1;
+  for (std::size_t k = 0; k < stages; ++k) {
+    const bool last = k + 1 == stages;
+    const Scenario stageScenario = continuationStage(scenario, k);
+    std::unique_ptr<MotionProblem> stageProblem = last ? nullptr : std::make_unique<MotionProblem>(stageScenario);
+    MotionProblem& current = last ? problem : *stageProblem;
+    if (current.variableCount() != problem.variableCount())
+      throw InputError("continuation stage " + std::to_string(k + 1) +
+                       ": its samples change the per-sample variables (epigraph slacks, contact_forces: variables)");
+    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian);
+    if (stages > 1) {
+      std::cout << "; stage " << k + 1 << " of " << stages << ": ν = " << stageScenario.actuators.frictionSharpness << " s/rad";
+      if (stageScenario.energyForm == EnergyForm::SmoothMaximum) std::cout << ", ε = " << stageScenario.smoothing << " W";
+      std::cout << ", " << stageScenario.samples << " samples";
     }
-    return stopRequested == 0;
-  });
+    std::cout << ")\n"
+              << "   iter      energy [J]   violation   dual inf.     elapsed" << (current.bilevel() ? "   infeasible samples" : "")
+              << "\n";
+    double lastCheckpoint = 0.0;
+    const IpoptOutcome outcome = solveWithIpopt(current, x, settings, [&](const IterationReport& r) {
+      std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
+                  r.elapsedSeconds);
+      const MotionProblem::InnerStatistics inner = current.innerStatistics();
+      if (current.bilevel()) std::printf("   %d", inner.infeasible);
+      std::printf("\n");
+      record.history.push_back({static_cast<int>(k), r.iteration, r.objective, r.violation, r.dualInfeasibility,
+                                r.elapsedSeconds, r.stepSize, r.regularisation, r.barrier, r.timings, inner});
+      std::fflush(stdout);
+      if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
+          r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
+        writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
+        lastCheckpoint = r.elapsedSeconds;
+      }
+      return stopRequested == 0;
+    });
+    const bool usable = outcome.x.size() == x.size() && outcome.x.allFinite();
+    if (usable) x = outcome.x;
+    record.stages.push_back({stageScenario.actuators.frictionSharpness, stageScenario.smoothing, stageScenario.samples,
+                             outcome.status,
+                             outcome.iterations, outcome.seconds, outcome.objective, outcome.timings});
+    if (last || outcome.status == OuterStatus::Interrupted || !usable) {
+      record.solver = outcome;
+      if (!last) {
+        record.solver.x = x;  // the last usable iterate, of an earlier stage
+        record.reason = "stopped in continuation stage " + std::to_string(k + 1) + " of " + std::to_string(stages) +
+                        " (" + toString(outcome.status) + ")";
+      }
+      break;
+    }
+  }
   record.optimisationSeconds = seconds(optimisationClock);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
@@ -166,7 +201,7 @@ int runMotion(const RunOptions& o) {
   record.message = record.solver.message;
   record.x = record.solver.x.size() == x0.size() && record.solver.x.allFinite() ? record.solver.x : x0;
   if (record.solver.x.size() != x0.size()) record.reason = "Ipopt returned no iterate; the initial motion is written";
-  if (!record.solver.evaluationError.empty()) record.reason = "evaluation failed: " + record.solver.evaluationError;
+  if (!record.solver.evaluationError.empty() && record.reason.empty()) record.reason = "evaluation failed: " + record.solver.evaluationError;
   if (record.status == OuterStatus::Interrupted) record.reason = "interrupted by a signal; the last iterate is written";
   else if (!record.solver.optimal() && record.reason.empty()) record.reason = "Ipopt: " + record.solver.message;
   record.totalSeconds = seconds(clock);
@@ -176,7 +211,13 @@ int runMotion(const RunOptions& o) {
             << "  status             " << toString(record.status) << "\n"
             << std::setprecision(6) << "  energy             " << energy << " J  (∫ Σ max(P, 0) dt at the samples)\n"
             << "  max violation      " << std::setprecision(3) << violation << "\n"
-            << "  iterations         " << record.solver.iterations << "\n"
+            << "  iterations         " << record.solver.iterations;
+  if (record.stages.size() > 1) {
+    std::cout << " (all stages:";
+    for (std::size_t k = 0; k < record.stages.size(); ++k) std::cout << (k == 0 ? " " : " + ") << record.stages[k].iterations;
+    std::cout << ")";
+  }
+  std::cout << "\n"
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
             << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";

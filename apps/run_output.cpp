@@ -136,7 +136,9 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   Json history = Json::array();
   SolveTimings previous;
   for (const IterationRecord& h : record.history) {
-    Json line = {{"iteration", h.iteration},
+    if (h.iteration == 0) previous = SolveTimings{};  // each stage's solve counts from zero
+    Json line = {{"stage", h.stage},
+                 {"iteration", h.iteration},
                  {"objective", h.objective},
                  {"violation", h.violation},
                  {"dual_infeasibility", h.dualInfeasibility},
@@ -155,11 +157,28 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
     history.push_back(line);
   }
   result["history"] = history;
+  Json stages = Json::array();
+  int totalIterations = 0;
+  SolveTimings all;  // over every stage
+  for (const StageRecord& stage : record.stages) {
+    all.functions += stage.timings.functions, all.derivatives += stage.timings.derivatives;
+    all.hessian += stage.timings.hessian, all.total += stage.timings.total;
+    stages.push_back({{"friction_sharpness", stage.frictionSharpness},
+                      {"smoothing", stage.smoothing},
+                      {"samples", stage.samples},
+                      {"status", toString(stage.status)},
+                      {"iterations", stage.iterations},
+                      {"seconds", stage.seconds},
+                      {"objective", stage.objective}});
+    totalIterations += stage.iterations;
+  }
+  result["continuation"] = stages;
+  result["solver"]["iterations_all_stages"] = totalIterations;
   result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},
                        {"total_seconds", record.totalSeconds},
-                       {"optimisation_split", split(record.solver.timings, SolveTimings{})}};
+                       {"optimisation_split", split(all, SolveTimings{})}};
 
   // The states as a `mcopt dynamics` input: re-evaluating them reproduces `torques`.
   Json states;

@@ -25,11 +25,22 @@ struct PostureOutcome {
 /// One Ipopt iteration as the progress line shows it, with the bilevel inner problems of the
 /// last evaluation before it (result.json `history`).
 struct IterationRecord {
+  int stage = 0;  ///< continuation stage (0 without continuation)
   int iteration = 0;
   double objective = 0.0, violation = 0.0, dualInfeasibility = 0.0, elapsedSeconds = 0.0;
   double stepSize = 0.0, regularisation = 0.0, barrier = 0.0;  ///< Ipopt's α_pr, δ_w and μ
   SolveTimings timings;  ///< cumulative up to this iteration
   MotionProblem::InnerStatistics inner;
+};
+
+/// One solved problem of a continuation (the scenario's own problem last).
+struct StageRecord {
+  double frictionSharpness = 0.0, smoothing = 0.0;
+  int samples = 0;
+  OuterStatus status = OuterStatus::InternalError;
+  int iterations = 0;
+  double seconds = 0.0, objective = 0.0;
+  SolveTimings timings;
 };
 
 struct RunRecord {
@@ -39,6 +50,7 @@ struct RunRecord {
   PostureOutcome start, end;
   IpoptOutcome solver;
   std::vector<IterationRecord> history;
+  std::vector<StageRecord> stages;  ///< one per continuation stage, the scenario's own problem last
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
 };
 

@@ -12,7 +12,7 @@ out="${1:-$root/out/table_3_1}"
 mkdir -p "$out"
 scenario="$root/scenarios/hrp2_kick.yaml"
 # The report's protocol: the same scenario with the limited-memory Hessian.
-sed -e 's/^hessian: finite-differences/hessian: limited-memory/' \
+sed -e 's/^hessian: .*/hessian: limited-memory/' \
     -e "s#\.\./robots#$root/robots#g" "$scenario" > "$out/hrp2_kick_lbfgs.yaml"
 
 field() { sed -n "s/^ \"$2\": \(.*\),\$/\1/p" "$1/result.json" | head -1 | tr -d '"'; }

@@ -37,6 +37,7 @@
 // the scenario's regularisation w Σ_s c_s Δt Σ_j q̈_js² (formulation.md §10; 0 by default).
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <limits>
 #include <memory>
 #include <string>
@@ -208,6 +209,7 @@ class MotionProblem final : public NlpProblem {
   struct HessianWorkspace {
     Eigen::VectorXd probeX, weights, base, gradient;
     Eigen::MatrixXd stateHessian, spread, local, sum;
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
     std::vector<int> columns;
   };
   void sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,

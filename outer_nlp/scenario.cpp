@@ -333,7 +333,8 @@ struct HessianName {
 };
 constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited-memory"},
                                          {HessianOption::FiniteDifferences, "finite-differences"},
-                                         {HessianOption::SampleDifferences, "sample-differences"}};
+                                         {HessianOption::SampleDifferences, "sample-differences"},
+                                         {HessianOption::ConvexSampleDifferences, "convex-sample-differences"}};
 }  // namespace
 
 const char* toString(HessianOption hessian) {
@@ -345,7 +346,8 @@ const char* toString(HessianOption hessian) {
 HessianOption parseHessianOption(const std::string& name) {
   for (const HessianName& h : kHessianNames)
     if (name == h.name) return h.option;
-  throw InputError("expected limited-memory, finite-differences or sample-differences, got '" + name + "'");
+  throw InputError("expected limited-memory, finite-differences, sample-differences or convex-sample-differences, got '" +
+                   name + "'");
 }
 
 Scenario loadScenario(const std::filesystem::path& file) {
@@ -355,7 +357,7 @@ Scenario loadScenario(const std::filesystem::path& file) {
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance"});
+                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance"});
   Scenario s;
   s.file = file;
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
@@ -495,8 +497,48 @@ Scenario loadScenario(const std::filesystem::path& file) {
     }
   }
 
+  if (const YAML::Node stages = root["continuation"]) {
+    if (!stages.IsSequence())
+      throw InputError(where(file, stages, "continuation") + "expected a list of {friction_sharpness, smoothing} stages");
+    for (std::size_t k = 0; k < stages.size(); ++k) {
+      const YAML::Node stage = stages[k];
+      const std::string field = "continuation[" + std::to_string(k) + "]";
+      if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
+      yaml::rejectUnknownKeys(file, stage, field, {"friction_sharpness", "smoothing", "samples"});
+      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples};
+      if (stage["friction_sharpness"])
+        c.frictionSharpness = yaml::positive(file, stage["friction_sharpness"], field + ".friction_sharpness");
+      if (stage["smoothing"]) {
+        if (s.energyForm != EnergyForm::SmoothMaximum)
+          throw InputError(where(file, stage["smoothing"], field + ".smoothing") + "only the smooth_max form is smoothed");
+        c.smoothing = yaml::positive(file, stage["smoothing"], field + ".smoothing");
+      }
+      if (stage["samples"]) {
+        // Per-sample variables (epigraph slacks, wrenches as variables) do not carry over
+        // from one grid to another; the spline parameters and force splines do.
+        if (s.energyForm == EnergyForm::Epigraph || (!s.contacts.empty() && s.contactForces == ContactForces::Variables))
+          throw InputError(where(file, stage["samples"], field + ".samples") +
+                           "the epigraph form and contact_forces: variables have variables per sample; a stage "
+                           "cannot change the samples");
+        c.samples = integerField(file, stage["samples"], field + ".samples", 2);
+      }
+      s.continuation.push_back(c);
+    }
+  }
+
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   return s;
+}
+
+Scenario continuationStage(const Scenario& scenario, std::size_t k) {
+  Scenario stage = scenario;
+  stage.continuation.clear();
+  if (k < scenario.continuation.size()) {
+    stage.actuators.frictionSharpness = scenario.continuation[k].frictionSharpness;
+    stage.smoothing = scenario.continuation[k].smoothing;
+    stage.samples = scenario.continuation[k].samples;
+  }
+  return stage;
 }
 
 }  // namespace mcopt

@@ -57,9 +57,13 @@ enum class HessianOption {
   LimitedMemory,      ///< Ipopt's quasi-Newton (L-BFGS) approximation, as the report
   FiniteDifferences,  ///< forward differences of the exact gradient, one whole evaluation per variable
   SampleDifferences,  ///< Σ_s B_sᵀ H_s B_s, H_s by differences of each sample's exact gradient in its state
+  /// The same with each H_s (and each task instant's) projected onto the positive
+  /// semidefinite cone (negative eigenvalues set to zero): a convex model, no inertia correction.
+  ConvexSampleDifferences,
 };
 const char* toString(HessianOption hessian);
-/// "limited-memory", "finite-differences" or "sample-differences"; throws InputError otherwise.
+/// "limited-memory", "finite-differences", "sample-differences" or "convex-sample-differences";
+/// throws InputError otherwise.
 HessianOption parseHessianOption(const std::string& name);
 
 /// A contact other than the reference body's: its surface is fixed in the world over the
@@ -130,7 +134,23 @@ struct Scenario {
 
   std::vector<SolverOption> solverOptions;
   HessianOption hessian = HessianOption::LimitedMemory;
+
+  /// Problems solved before this one, each from the previous one's result (the first from
+  /// the initial motion), with a smoother friction model and/or smooth maximum: the dry
+  /// friction's steep atan(ν N q̇) makes the kick's Lagrangian indefinite at every joint that
+  /// is nearly still, and Newton's steps need hundreds of iterations there
+  /// (docs/scenarios.md, "Hessian and convergence"). The scenario's own problem is solved last.
+  struct ContinuationStage {
+    double frictionSharpness = 0.0;  ///< ν [s/rad]
+    double smoothing = 0.0;          ///< ε [W]
+    int samples = 0;                 ///< N: a coarser grid, the same spline parameters
+  };
+  std::vector<ContinuationStage> continuation;
 };
+
+/// Stage k of the scenario's continuation (k = continuation.size(): the scenario itself):
+/// a copy with that stage's friction sharpness, smoothing and samples.
+Scenario continuationStage(const Scenario& scenario, std::size_t k);
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws
 /// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints

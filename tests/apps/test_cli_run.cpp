@@ -208,6 +208,53 @@ TEST_CASE("run: a run killed outright leaves its latest checkpoint, the iterate 
   CHECK(killed["energy"].get<double>() == Approx(ended["energy"].get<double>()).epsilon(1e-9));
 }
 
+TEST_CASE("run: a continuation solves its stages in turn, each from the last one's iterate", "[cli][run]") {
+  // Two coarse stages (a smoother friction, then the scenario's) before the scenario's own
+  // problem, a few iterations each: result.json lists the stages, the history says which
+  // stage each iteration belongs to, and the time split adds up to the solve.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 20;
+    root["hessian"] = "sample-differences";
+    root["continuation"] = YAML::Load("[{samples: 10, friction_sharpness: 0.01}, {samples: 10}]");
+    root["solver"]["max_iter"] = 3;
+  });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --configuration-optimisation off");
+  INFO(r.all());
+  // A stage stopped by its iteration limit hands its iterate on; the last one's status is the run's.
+  REQUIRE(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("stage 1 of 3: ν = 0.01 s/rad, ε = 1 W, 10 samples") &&
+                           Contains("stage 3 of 3: ν = 1 s/rad, ε = 1 W, 20 samples") && Contains("(all stages: 3 + 3 + 3)"));
+  const Json result = readJson(out / "result.json");
+  REQUIRE(result["continuation"].size() == 3);
+  CHECK(result["continuation"][0]["friction_sharpness"] == 0.01);
+  CHECK(result["continuation"][0]["samples"] == 10);
+  CHECK(result["continuation"][2]["samples"] == 20);
+  CHECK(result["continuation"][2]["status"] == "maximum_iterations");
+  CHECK(result["solver"]["iterations"] == 3);
+  CHECK(result["solver"]["iterations_all_stages"] == 9);
+  CHECK(result["solver"]["hessian"] == "sample-differences");
+  REQUIRE(result["history"].size() == 12);  // iterations 0 … 3 of each stage
+  CHECK(result["history"][4]["stage"] == 1);
+  CHECK(result["history"][4]["iteration"] == 0);
+  CHECK(result["history"][11]["stage"] == 2);
+  double split = 0.0;
+  for (const Json& line : result["history"])
+    for (const char* part : {"functions", "gradient_and_jacobian", "hessian", "ipopt"}) {
+      CHECK(line["seconds"][part].get<double>() >= 0.0);
+      split += line["seconds"][part].get<double>();
+    }
+  CHECK(result["history"][3]["seconds"]["hessian"].get<double>() > 0.0);
+  const double solve = result["timings"]["optimisation_seconds"].get<double>();
+  const Json whole = result["timings"]["optimisation_split"];
+  const double parts = whole["functions"].get<double>() + whole["gradient_and_jacobian"].get<double>() +
+                       whole["hessian"].get<double>() + whole["ipopt"].get<double>();
+  CHECK(parts <= solve);
+  CHECK(parts >= 0.8 * solve);  // the stages' problems are built between the solves
+  CHECK(split <= parts + 1e-9);
+}
+
 TEST_CASE("run: every class of bad scenario is refused with file, line and field", "[cli][run]") {
   const test::TempDir dir;
   struct Case {
@@ -264,6 +311,19 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"unknown Ipopt option", [](YAML::Node& r) { r["solver"]["max_iterations"] = 10; },
        {"solver.max_iterations: Ipopt rejects option 'max_iterations'"}},
       {"Ipopt option out of range", [](YAML::Node& r) { r["solver"]["tol"] = -1.0; }, {"solver.tol: Ipopt rejects option 'tol'"}},
+      {"unknown Hessian option", [](YAML::Node& r) { r["hessian"] = "exact"; },
+       {"hessian: expected limited-memory, finite-differences, sample-differences or convex-sample-differences, got 'exact'"}},
+      {"continuation not a list", [](YAML::Node& r) { r["continuation"] = 3; }, {"continuation: expected a list"}},
+      {"unknown continuation field", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{tol: 1.0}]"); },
+       {"continuation[0].tol: unknown key"}},
+      {"continuation sharpness not positive", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{samples: 25}, {friction_sharpness: 0.0}]");
+       }, {"continuation[1].friction_sharpness: must be positive"}},
+      {"continuation samples with per-sample variables", [](YAML::Node& r) {
+         r["objective"]["energy"] = "epigraph";
+         r["objective"].remove("smoothing");
+         r["continuation"] = YAML::Load("[{samples: 25}]");
+       }, {"continuation[0].samples: the epigraph form and contact_forces: variables have variables per sample"}},
   };
   for (std::size_t i = 0; i < cases.size(); ++i) {
     if (kUnderSanitizers && i % 3 != 0) continue;  // every third class; the Release build runs all
