@@ -169,11 +169,17 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
                       {"status", toString(stage.status)},
                       {"iterations", stage.iterations},
                       {"seconds", stage.seconds},
-                      {"objective", stage.objective}});
+                      {"objective", stage.objective},
+                      {"screening_rounds", stage.rounds},
+                      {"torque_rows_checked_afterwards", stage.omittedTorqueRows}});
     totalIterations += stage.iterations;
   }
   result["continuation"] = stages;
   result["solver"]["iterations_all_stages"] = totalIterations;
+  if (!record.stages.empty()) {
+    result["solver"]["screening_rounds"] = record.stages.back().rounds;
+    result["solver"]["torque_rows_checked_afterwards"] = record.stages.back().omittedTorqueRows;
+  }
   result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},

@@ -38,9 +38,11 @@ struct StageRecord {
   double frictionSharpness = 0.0, smoothing = 0.0;
   int samples = 0;
   OuterStatus status = OuterStatus::InternalError;
-  int iterations = 0;
+  int iterations = 0;            ///< over its screening rounds
   double seconds = 0.0, objective = 0.0;
   SolveTimings timings;
+  int rounds = 0;                ///< solves: 1 + the times torque-limit rows joined
+  int omittedTorqueRows = 0;     ///< torque-limit rows out of the last solve, checked at its result
 };
 
 struct RunRecord {

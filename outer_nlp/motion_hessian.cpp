@@ -181,10 +181,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const auto lambda = taskMultipliers_.col(i);
       if ((lambda.array() == 0.0).all()) continue;  // no bounded component
       const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
-      const int d = 2 * n;  // tasks read positions and velocities
+      // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
+      const TaskKind kind = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])].kind;
+      const bool velocity = kind == TaskKind::LinearVelocity || kind == TaskKind::AngularVelocity;
+      const int d = velocity ? 2 * n : n;
       h.base.resize(d), h.gradient.resize(d), h.stateHessian.resize(d, d);
       h.base.head(n).noalias() = b.dyDq.transpose() * lambda;
-      h.base.tail(n).noalias() = b.dyDv.transpose() * lambda;
+      if (velocity) h.base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
       for (int c = 0; c < d; ++c) {
         double& component = c < n ? w.q[c] : w.v[c - n];
@@ -193,12 +196,12 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         taskOutputs(i, true, w, taskProbe);
         component = saved;
         h.gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
-        h.gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+        if (velocity) h.gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
         h.stateHessian.col(c) = (h.gradient - h.base) / step;
       }
       h.stateHessian = 0.5 * (h.stateHessian + h.stateHessian.transpose()).eval();
       project();
-      spread(taskSamples_.weights(i), b.parameters, 2, {});
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {});
     }
   }
 

@@ -82,7 +82,7 @@ const char* constraintKindName(ConstraintKind kind) {
   return "?";
 }
 
-MotionProblem::MotionProblem(const Scenario& scenario)
+MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows)
     : scenario_(scenario),
       model_(scenario.robot, scenario.referenceBody, scenario.referencePose, scenario.gravity),
       parametrization_(scenario.robot.jointCount(), scenario.controlPoints),
@@ -92,6 +92,9 @@ MotionProblem::MotionProblem(const Scenario& scenario)
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
+  omittedTorqueRows_ = std::move(omittedTorqueRows);
+  if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * scenario_.samples))
+    throw InputError("motion problem: the torque-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());
   outputs_.joints = jointCount_, outputs_.contacts = contacts;
   forceStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
@@ -189,6 +192,25 @@ std::vector<ContactSurface> MotionProblem::surfacesInContact(int sample) const {
   return surfaces;
 }
 
+std::vector<bool> MotionProblem::torquesBelow(const Eigen::VectorXd& x, double fraction) {
+  evaluate(x, false);
+  std::vector<bool> below(static_cast<std::size_t>(jointCount_ * scenario_.samples), true);
+  for (int s = 0; s < scenario_.samples; ++s)
+    for (const int j : torqueJoints_) {
+      const double limit = scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit;
+      below[static_cast<std::size_t>(s * jointCount_ + j)] =
+          std::abs(blocks_[static_cast<std::size_t>(s)].y[outputs_.torque(j)]) < fraction * limit;
+    }
+  return below;
+}
+
+int MotionProblem::omittedTorqueRowCount() const {
+  int count = 0;
+  for (int s = 0; s < scenario_.samples && !omittedTorqueRows_.empty(); ++s)
+    for (const int j : torqueJoints_) count += omittedTorqueRows_[static_cast<std::size_t>(s * jointCount_ + j)];
+  return count;
+}
+
 MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
   InnerStatistics statistics;
   for (const auto& sample : bilevelSamples_) {
@@ -237,7 +259,8 @@ void MotionProblem::buildStructure() {
   const int contacts = outputs_.contacts;
   for (int s = 0; s < samples_.sampleCount(); ++s) {
     for (const int j : torqueJoints_)
-      sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
+      if (omittedTorqueRows_.empty() || !omittedTorqueRows_[static_cast<std::size_t>(s * jointCount_ + j)])
+        sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
                 true);
     if (scenario_.contactConstraints && explicitForces) {
       for (int c = 0; c < 6; ++c)

@@ -90,7 +90,15 @@ struct SampledPhysics {
 
 class MotionProblem final : public NlpProblem {
  public:
-  explicit MotionProblem(const Scenario& scenario);
+  /// `omittedTorqueRows` (empty, or one flag per joint and sample, index s · n + j) leaves
+  /// those torque-limit rows out of the NLP: torque-limit screening (formulation.md §10;
+  /// docs/scenarios.md), where rows far from their bound are checked after the solve
+  /// instead of weighing on every KKT factorisation.
+  explicit MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows = {});
+  /// Per joint and sample (index s · n + j): whether |Γ_js| < fraction · its limit at x
+  /// (joints without a finite limit: true). For torque-limit screening.
+  std::vector<bool> torquesBelow(const Eigen::VectorXd& x, double fraction);
+  int omittedTorqueRowCount() const;
   ~MotionProblem() override;
   const SupportContactRows& support() const { return support_; }
 
@@ -237,6 +245,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
   std::vector<SupportContactRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit
+  std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants
   std::vector<std::vector<int>> taskJoints_;     ///< per task instant: joints that move the task's body

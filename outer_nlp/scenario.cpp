@@ -430,10 +430,17 @@ Scenario loadScenario(const std::filesystem::path& file) {
   }
   if (root["limits"]) {
     const YAML::Node l = root["limits"];
-    yaml::rejectUnknownKeys(file, l, "limits", {"position", "velocity", "torque", "contact", "minimum_normal_force"});
+    yaml::rejectUnknownKeys(file, l, "limits",
+                            {"position", "velocity", "torque", "torque_screening", "contact", "minimum_normal_force"});
     if (l["position"]) s.positionLimits = flag(file, l["position"], "limits.position");
     if (l["velocity"]) s.velocityLimits = flag(file, l["velocity"], "limits.velocity");
     if (l["torque"]) s.torqueLimits = flag(file, l["torque"], "limits.torque");
+    if (l["torque_screening"]) {
+      s.torqueScreening = yaml::nonNegative(file, l["torque_screening"], "limits.torque_screening");
+      if (s.torqueScreening >= 1.0)
+        throw InputError(where(file, l["torque_screening"], "limits.torque_screening") +
+                         "expected a fraction of the limit in [0, 1) (0: every row in the problem)");
+    }
     if (l["contact"]) s.contactConstraints = flag(file, l["contact"], "limits.contact");
     if (l["minimum_normal_force"])
       s.minimumNormalForce = yaml::nonNegative(file, l["minimum_normal_force"], "limits.minimum_normal_force");

@@ -125,6 +125,10 @@ struct Scenario {
   double accelerationWeight = 0.0; ///< w of the regularisation w ∫ Σ_j q̈_j² dt [J s⁴/rad²/s]
 
   bool positionLimits = true, velocityLimits = true, torqueLimits = true;
+  /// Torque-limit rows whose |Γ| stays below this fraction of the limit are left out of the
+  /// NLP and checked after the solve; rows that reach it join and the problem is solved
+  /// again (docs/scenarios.md, "Torque-limit screening"). 0: every row in the NLP.
+  double torqueScreening = 0.5;
   std::vector<TaskSpec> tasks;
 
   Eigen::VectorXd start, end;      ///< initial guesses for the start and end postures [rad]
@@ -133,7 +137,7 @@ struct Scenario {
   int configurationIterations = 500;
 
   std::vector<SolverOption> solverOptions;
-  HessianOption hessian = HessianOption::LimitedMemory;
+  HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/scenarios.md)
 
   /// Problems solved before this one, each from the previous one's result (the first from
   /// the initial motion), with a smoother friction model and/or smooth maximum: the dry

@@ -1,0 +1,88 @@
+// Torque-limit screening (docs/scenarios.md, "Torque-limit screening"): the motion problem
+// with some torque-limit rows left out is the full problem minus exactly those rows — same
+// objective and gradient, every remaining row with the same value, bounds and Jacobian —, and
+// the rows it leaves out are the ones whose |Γ| is below the fraction of their limit.
+#include <catch2/catch.hpp>
+
+#include <map>
+#include <random>
+
+#include "common/nlp_jacobian.hpp"
+#include "common/test_support.hpp"
+#include "core/errors.hpp"
+#include "outer_nlp/motion_problem.hpp"
+
+namespace mcopt {
+
+TEST_CASE("torque-limit screening: the screened problem is the full one without those rows", "[outer][screening]") {
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
+  s.samples = 16;
+  s.outputSamples = 20;
+  MotionProblem full(s);
+  Eigen::VectorXd x = full.initialPoint(s.start, s.end);
+  std::mt19937 random(17);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  for (int i = 0; i < full.parametrization().parameterCount(); ++i) x[i] += u(random);
+
+  const double fraction = 0.05;
+  const std::vector<bool> below = full.torquesBelow(x, fraction);
+  const SampledPhysics physics = full.sampledPhysics(x);
+  int omitted = 0, kept = 0;
+  for (int sample = 0; sample < s.samples; ++sample)
+    for (int j = 0; j < 30; ++j) {
+      const double limit = s.actuators.joints[static_cast<std::size_t>(j)].torqueLimit;
+      const bool isBelow = below[static_cast<std::size_t>(sample * 30 + j)];
+      CHECK(isBelow == (std::abs(physics.tau(j, sample)) < fraction * limit));
+      (isBelow ? omitted : kept) += 1;
+    }
+  INFO(omitted << " rows below " << fraction << " of their limit, " << kept << " above");
+  REQUIRE(omitted > 0);
+  REQUIRE(kept > 0);  // both kinds present: the check means something
+
+  MotionProblem screened(s, below);
+  CHECK(screened.omittedTorqueRowCount() == omitted);
+  REQUIRE(screened.constraintCount() == full.constraintCount() - omitted);
+  CHECK(screened.variableCount() == full.variableCount());
+  CHECK(screened.objective(x) == full.objective(x));
+  Eigen::VectorXd gradientFull, gradientScreened;
+  full.objectiveGradient(x, gradientFull);
+  screened.objectiveGradient(x, gradientScreened);
+  CHECK(gradientScreened == gradientFull);
+
+  // Every remaining row, found in the full problem by its name (and which of the rows of that
+  // name it is: a joint's velocity-limit rows share one): the same value, bounds and Jacobian row.
+  auto keys = [](const MotionProblem& problem) {
+    std::vector<std::string> key;
+    std::map<std::string, int> seen;
+    for (int r = 0; r < problem.constraintCount(); ++r) {
+      const std::string name = problem.rowName(r);
+      key.push_back(name + "#" + std::to_string(seen[name]++));
+    }
+    return key;
+  };
+  const std::vector<std::string> fullKeys = keys(full), screenedKeys = keys(screened);
+  std::map<std::string, int> fullRows;
+  for (int r = 0; r < full.constraintCount(); ++r) fullRows[fullKeys[static_cast<std::size_t>(r)]] = r;
+  Eigen::VectorXd gFull, gScreened, lowerFull, upperFull, lowerScreened, upperScreened;
+  full.constraints(x, gFull);
+  screened.constraints(x, gScreened);
+  full.constraintBounds(lowerFull, upperFull);
+  screened.constraintBounds(lowerScreened, upperScreened);
+  const Eigen::MatrixXd jacobianFull = test::denseJacobian(full, x), jacobianScreened = test::denseJacobian(screened, x);
+  int torqueRows = 0;
+  for (int r = 0; r < screened.constraintCount(); ++r) {
+    const auto found = fullRows.find(screenedKeys[static_cast<std::size_t>(r)]);
+    REQUIRE(found != fullRows.end());
+    const int f = found->second;
+    CHECK(gScreened[r] == gFull[f]);
+    CHECK(lowerScreened[r] == lowerFull[f]);
+    CHECK(upperScreened[r] == upperFull[f]);
+    CHECK((jacobianScreened.row(r) - jacobianFull.row(f)).cwiseAbs().maxCoeff() == 0.0);
+    torqueRows += screened.rowKind(r) == ConstraintKind::TorqueLimit;
+  }
+  CHECK(torqueRows == kept);
+
+  CHECK_THROWS_AS(MotionProblem(s, std::vector<bool>(7, true)), InputError);
+}
+
+}  // namespace mcopt
