@@ -87,6 +87,14 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     std::size_t forceColumns = 0;
     for (const SampleBlock& b : blocks_) forceColumns = std::max(forceColumns, b.forceColumns.size());
     const int outputs = outputs_.size(), contacts = outputs_.contacts;
+    // Sized once for the largest sample (3n states + its force columns): the per-sample
+    // loop below works on leading blocks and allocates nothing.
+    const int largest = 3 * n + static_cast<int>(forceColumns), largestLocal = 4 * n + static_cast<int>(forceColumns);
+    for (HessianWorkspace& h : hessianWorkspaces_) {
+      h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
+      h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
+      h.local.setZero(largestLocal, largestLocal), h.columns.reserve(static_cast<std::size_t>(largestLocal));
+    }
     probes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
@@ -110,15 +118,20 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // Adds Bᵀ H B to the thread's sum: B maps the local spline parameters (k per joint, their
     // weights in q, q̇ = (1/T) dq/du, q̈ = (1/T²) d²q/du²) and the force columns to the state.
     const bool convex = scenario_.hessian == HessianOption::ConvexSampleDifferences;
-    auto project = [&] {
+    // Symmetrises the leading d × d block of the state Hessian (and, for the convex option,
+    // projects it onto the positive semidefinite cone).
+    auto symmetrise = [&](int d) {
+      auto H = h.stateHessian.topLeftCorner(d, d);
+      for (int r = 0; r < d; ++r)
+        for (int c = 0; c < r; ++c) H(r, c) = H(c, r) = 0.5 * (H(r, c) + H(c, r));
       if (!convex) return;
-      h.eigen.compute(h.stateHessian);
-      h.stateHessian.noalias() = h.eigen.eigenvectors() * h.eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
-                                 h.eigen.eigenvectors().transpose();
+      h.eigen.compute(H);
+      H.noalias() = h.eigen.eigenvectors() * h.eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+                    h.eigen.eigenvectors().transpose();
     };
     auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
                       const std::vector<int>& forceColumns) {
-      const int k = weights.count, d = static_cast<int>(h.stateHessian.rows()), nf = static_cast<int>(forceColumns.size());
+      const int k = weights.count, nf = static_cast<int>(forceColumns.size()), d = stateBlocks * n + nf;
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
       auto weight = [&](int block, int l) {
@@ -126,24 +139,25 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                                : block == 1 ? weights.d1[static_cast<std::size_t>(l)]
                                             : weights.d2[static_cast<std::size_t>(l)]);
       };
-      h.spread.setZero(d, local);  // H B
+      const auto H = h.stateHessian.topLeftCorner(d, d);
+      auto HB = h.spread.topLeftCorner(d, local);  // H B
+      HB.setZero();
       for (int j = 0; j < n; ++j)
         for (int l = 0; l < k; ++l)
-          for (int block = 0; block < stateBlocks; ++block)
-            h.spread.col(j * k + l) += weight(block, l) * h.stateHessian.col(block * n + j);
-      for (int f = 0; f < nf; ++f) h.spread.col(n * k + f) = h.stateHessian.col(stateBlocks * n + f);
-      h.local.setZero(local, local);  // Bᵀ H B
+          for (int block = 0; block < stateBlocks; ++block) HB.col(j * k + l) += weight(block, l) * H.col(block * n + j);
+      for (int f = 0; f < nf; ++f) HB.col(n * k + f) = H.col(stateBlocks * n + f);
+      auto BHB = h.local.topLeftCorner(local, local);  // Bᵀ H B
+      BHB.setZero();
       for (int j = 0; j < n; ++j)
         for (int l = 0; l < k; ++l)
-          for (int block = 0; block < stateBlocks; ++block)
-            h.local.row(j * k + l) += weight(block, l) * h.spread.row(block * n + j);
-      for (int f = 0; f < nf; ++f) h.local.row(n * k + f) = h.spread.row(stateBlocks * n + f);
+          for (int block = 0; block < stateBlocks; ++block) BHB.row(j * k + l) += weight(block, l) * HB.row(block * n + j);
+      for (int f = 0; f < nf; ++f) BHB.row(n * k + f) = HB.row(stateBlocks * n + f);
       h.columns.resize(static_cast<std::size_t>(local));
       for (int c = 0; c < n * k; ++c) h.columns[static_cast<std::size_t>(c)] = parameters[c];
       for (int f = 0; f < nf; ++f) h.columns[static_cast<std::size_t>(n * k + f)] = forceColumns[static_cast<std::size_t>(f)];
       for (int r = 0; r < local; ++r)
         for (int c = 0; c < local; ++c)
-          h.sum(h.columns[static_cast<std::size_t>(r)], h.columns[static_cast<std::size_t>(c)]) += h.local(r, c);
+          h.sum(h.columns[static_cast<std::size_t>(r)], h.columns[static_cast<std::size_t>(c)]) += BHB(r, c);
     };
 
 #pragma omp for schedule(static)
@@ -152,8 +166,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
       const double objectiveWeight = objectiveFactor * ((s == 0 || s == N - 1) ? 0.5 * dt : dt);
       const auto lambda = sampleMultipliers_.col(s);
-      h.base.resize(d), h.gradient.resize(d), h.stateHessian.resize(d, d);
-      sampleLagrangianGradient(b, lambda, objectiveWeight, h, h.base);
+      auto base = h.base.head(d), gradient = h.gradient.head(d);
+      sampleLagrangianGradient(b, lambda, objectiveWeight, h, base);
       samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
       for (int c = 0; c < d; ++c) {
         // Perturb one state component (or force variable), evaluate the sample there.
@@ -165,14 +179,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         *component = saved + step;
         sampleOutputs(s, h.probeX, true, w, probe);
         *component = saved;
-        sampleLagrangianGradient(probe, lambda, objectiveWeight, h, h.gradient);
-        h.stateHessian.col(c) = (h.gradient - h.base) / step;
+        sampleLagrangianGradient(probe, lambda, objectiveWeight, h, gradient);
+        h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       // A bilevel sample keeps its last inner solution (its warm start, its reported status):
       // leave it at the unperturbed state.
       if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
-      h.stateHessian = 0.5 * (h.stateHessian + h.stateHessian.transpose()).eval();
-      project();
+      symmetrise(d);
       spread(samples_.weights(s), b.parameters, 3, b.forceColumns);
     }
 
@@ -185,9 +198,9 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const TaskKind kind = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])].kind;
       const bool velocity = kind == TaskKind::LinearVelocity || kind == TaskKind::AngularVelocity;
       const int d = velocity ? 2 * n : n;
-      h.base.resize(d), h.gradient.resize(d), h.stateHessian.resize(d, d);
-      h.base.head(n).noalias() = b.dyDq.transpose() * lambda;
-      if (velocity) h.base.tail(n).noalias() = b.dyDv.transpose() * lambda;
+      auto base = h.base.head(d), gradient = h.gradient.head(d);
+      base.head(n).noalias() = b.dyDq.transpose() * lambda;
+      if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
       for (int c = 0; c < d; ++c) {
         double& component = c < n ? w.q[c] : w.v[c - n];
@@ -195,12 +208,11 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         component = saved + step;
         taskOutputs(i, true, w, taskProbe);
         component = saved;
-        h.gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
-        if (velocity) h.gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
-        h.stateHessian.col(c) = (h.gradient - h.base) / step;
+        gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
+        if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+        h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
-      h.stateHessian = 0.5 * (h.stateHessian + h.stateHessian.transpose()).eval();
-      project();
+      symmetrise(d);
       spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {});
     }
   }

@@ -111,20 +111,22 @@ TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) alloca
 
 TEST_CASE("the outer problem's evaluation allocates nothing once warm: one contact and each multi-contact formulation",
           "[outer][allocation]") {
-  // What Ipopt calls per iterate: objective, gradient, constraints, Jacobian values.
+  // What Ipopt calls per iterate: objective, gradient, constraints, Jacobian values, Hessian.
   for (const char* file : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml"})
     for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
       Scenario scenario = loadScenario(test::sourceDir() / "scenarios" / file);
       scenario.samples = 20;
       scenario.contactForces = forces;
       MotionProblem problem(scenario);
-      Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end), gradient, constraints, jacobian;
+      Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end), gradient, constraints, jacobian, hessian;
+      const Eigen::VectorXd multipliers = Eigen::VectorXd::Constant(problem.constraintCount(), 0.5);
       double objective = 0.0;
       auto evaluateAll = [&] {
         objective = problem.objective(x);
         problem.objectiveGradient(x, gradient);
         problem.constraints(x, constraints);
         problem.jacobianValues(x, jacobian);
+        problem.lagrangianHessian(x, 1.0, multipliers, hessian);  // the sample-differences Hessian
       };
       evaluateAll();  // set-up: buffers sized, inner solvers warm
       std::mt19937 rng(9);
