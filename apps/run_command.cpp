@@ -11,14 +11,13 @@
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
-#include <memory>
 
 #include "apps/commands.hpp"
 #include "apps/run_output.hpp"
-#include "core/errors.hpp"
 #include "outer_nlp/configuration_problem.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/motion_solve.hpp"
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt::cli {
@@ -140,101 +139,47 @@ int runMotion(const RunOptions& o) {
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
   const auto optimisationClock = std::chrono::steady_clock::now();
-  // The continuation's stages (docs/scenarios.md, "Hessian and convergence"), each from the
-  // previous one's iterate, then the scenario's own problem.
-  Eigen::VectorXd x = x0;
-  const std::size_t stages = scenario.continuation.size() + 1;
-  for (std::size_t k = 0; k < stages; ++k) {
-    const bool last = k + 1 == stages;
-    const Scenario stageScenario = continuationStage(scenario, k);
-    std::unique_ptr<MotionProblem> stageProblem = last ? nullptr : std::make_unique<MotionProblem>(stageScenario);
-    MotionProblem& full = last ? problem : *stageProblem;
-    if (full.variableCount() != problem.variableCount())
-      throw InputError("continuation stage " + std::to_string(k + 1) +
-                       ": its samples change the per-sample variables (epigraph slacks, contact_forces: variables)");
-    // Torque-limit screening: rows far from their bound stay out of the NLP; after a solve,
-    // those that came near it join and the problem is solved again from there.
-    std::vector<bool> omitted;
-    if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
-    IpoptOutcome outcome;
-    StageRecord stage;
-    stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
-    stage.smoothing = stageScenario.smoothing;
-    stage.samples = stageScenario.samples;
-    for (;;) {
-      MotionProblem current(stageScenario, omitted);
-      stage.omittedTorqueRows = current.omittedTorqueRowCount();
-      std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian);
-      if (stages > 1) {
-        std::cout << "; stage " << k + 1 << " of " << stages << ": ν = " << stageScenario.actuators.frictionSharpness
-                  << " s/rad";
-        if (stageScenario.energyForm == EnergyForm::SmoothMaximum) std::cout << ", ε = " << stageScenario.smoothing << " W";
-        std::cout << ", " << stageScenario.samples << " samples";
-      }
-      if (!omitted.empty())
-        std::cout << "; " << current.omittedTorqueRowCount() << " torque-limit rows below "
-                  << scenario.torqueScreening << " of their limit checked afterwards";
-      std::cout << ")\n"
-                << "   iter      energy [J]   violation   dual inf.     elapsed"
-                << (current.bilevel() ? "   infeasible samples" : "") << "\n";
-      double lastCheckpoint = 0.0;
-      // A screening round starts at the previous round's optimum: a small barrier parameter
-      // keeps Ipopt near it instead of re-centring the iterate (ours first: the scenario's
-      // `solver` options still override it).
-      IpoptSettings roundSettings = settings;
-      if (stage.rounds > 0) {
-        SolverOption barrier;
-        barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = 1e-4;
-        barrier.text = "1e-4", barrier.origin = "torque-limit screening: ";
-        roundSettings.options.insert(roundSettings.options.begin(), barrier);
-      }
-      outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
-        std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
-                    r.elapsedSeconds);
-        const MotionProblem::InnerStatistics inner = current.innerStatistics();
-        if (current.bilevel()) std::printf("   %d", inner.infeasible);
-        std::printf("\n");
-        record.history.push_back({static_cast<int>(k), r.iteration, r.objective, r.violation, r.dualInfeasibility,
-                                  r.elapsedSeconds, r.stepSize, r.regularisation, r.barrier, r.timings, inner});
-        std::fflush(stdout);
-        if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
-            r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
-          writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
-          lastCheckpoint = r.elapsedSeconds;
-        }
-        return stopRequested == 0;
-      });
-      ++stage.rounds;
-      stage.iterations += outcome.iterations;
-      stage.seconds += outcome.seconds;
-      stage.timings.functions += outcome.timings.functions, stage.timings.derivatives += outcome.timings.derivatives;
-      stage.timings.hessian += outcome.timings.hessian, stage.timings.total += outcome.timings.total;
-      if (outcome.x.size() != x.size() || !outcome.x.allFinite() || !outcome.optimal() || omitted.empty()) break;
-      // The solution is optimal for the rows in the problem; it is for all of them when every
-      // omitted row is still below its fraction (then strictly inside its bound, multiplier 0).
-      const std::vector<bool> below = full.torquesBelow(outcome.x, scenario.torqueScreening);
-      int joined = 0;
-      for (std::size_t i = 0; i < omitted.size(); ++i)
-        if (omitted[i] && !below[i]) omitted[i] = false, ++joined;
-      if (joined == 0) break;
-      x = outcome.x;
-      std::cout << "  " << joined << " torque-limit rows came within " << scenario.torqueScreening
+  double lastCheckpoint = 0.0;
+  MotionSolveEvents events;
+  events.onSolve = [&](const SolveStart& solve) {
+    if (solve.joinedTorqueRows > 0)
+      std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.torqueScreening
                 << " of their limit: solving again with them\n";
+    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian);
+    if (solve.stages > 1) {
+      std::cout << "; stage " << solve.stage + 1 << " of " << solve.stages << ": ν = "
+                << solve.scenario.actuators.frictionSharpness << " s/rad";
+      if (solve.scenario.energyForm == EnergyForm::SmoothMaximum) std::cout << ", ε = " << solve.scenario.smoothing << " W";
+      std::cout << ", " << solve.scenario.samples << " samples";
     }
-    const bool usable = outcome.x.size() == x.size() && outcome.x.allFinite();
-    if (usable) x = outcome.x;
-    stage.status = outcome.status, stage.objective = outcome.objective;
-    record.stages.push_back(stage);
-    if (last || outcome.status == OuterStatus::Interrupted || !usable) {
-      record.solver = outcome;
-      if (!last) {
-        record.solver.x = x;  // the last usable iterate, of an earlier stage
-        record.reason = "stopped in continuation stage " + std::to_string(k + 1) + " of " + std::to_string(stages) +
-                        " (" + toString(outcome.status) + ")";
-      }
-      break;
+    if (solve.problem.omittedTorqueRowCount() > 0)
+      std::cout << "; " << solve.problem.omittedTorqueRowCount() << " torque-limit rows below " << scenario.torqueScreening
+                << " of their limit checked afterwards";
+    std::cout << ")\n"
+              << "   iter      energy [J]   violation   dual inf.     elapsed"
+              << (solve.problem.bilevel() ? "   infeasible samples" : "") << "\n";
+    lastCheckpoint = 0.0;
+  };
+  events.onIteration = [&](int stage, const MotionProblem& current, const IterationReport& r) {
+    std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
+                r.elapsedSeconds);
+    const MotionProblem::InnerStatistics inner = current.innerStatistics();
+    if (current.bilevel()) std::printf("   %d", inner.infeasible);
+    std::printf("\n");
+    record.history.push_back({stage, r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds,
+                              r.stepSize, r.regularisation, r.barrier, r.timings, inner});
+    std::fflush(stdout);
+    if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
+        r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
+      writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
+      lastCheckpoint = r.elapsedSeconds;
     }
-  }
+    return stopRequested == 0;
+  };
+  MotionSolveOutcome solved = solveMotion(scenario, problem, x0, settings, events);
+  record.solver = std::move(solved.solver);
+  record.stages = std::move(solved.stages);
+  record.reason = solved.reason;
   record.optimisationSeconds = seconds(optimisationClock);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);

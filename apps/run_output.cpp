@@ -160,9 +160,8 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   Json stages = Json::array();
   int totalIterations = 0;
   SolveTimings all;  // over every stage
-  for (const StageRecord& stage : record.stages) {
-    all.functions += stage.timings.functions, all.derivatives += stage.timings.derivatives;
-    all.hessian += stage.timings.hessian, all.total += stage.timings.total;
+  for (const StageOutcome& stage : record.stages) {
+    all += stage.timings;
     stages.push_back({{"friction_sharpness", stage.frictionSharpness},
                       {"smoothing", stage.smoothing},
                       {"samples", stage.samples},

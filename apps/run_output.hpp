@@ -10,6 +10,7 @@
 
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/motion_solve.hpp"
 
 namespace mcopt::cli {
 
@@ -33,18 +34,6 @@ struct IterationRecord {
   MotionProblem::InnerStatistics inner;
 };
 
-/// One solved problem of a continuation (the scenario's own problem last).
-struct StageRecord {
-  double frictionSharpness = 0.0, smoothing = 0.0;
-  int samples = 0;
-  OuterStatus status = OuterStatus::InternalError;
-  int iterations = 0;            ///< over its screening rounds
-  double seconds = 0.0, objective = 0.0;
-  SolveTimings timings;
-  int rounds = 0;                ///< solves: 1 + the times torque-limit rows joined
-  int omittedTorqueRows = 0;     ///< torque-limit rows out of the last solve, checked at its result
-};
-
 struct RunRecord {
   OuterStatus status = OuterStatus::InternalError;
   std::string message, reason;  ///< reason: why a run that is not optimal ended
@@ -52,7 +41,7 @@ struct RunRecord {
   PostureOutcome start, end;
   IpoptOutcome solver;
   std::vector<IterationRecord> history;
-  std::vector<StageRecord> stages;  ///< one per continuation stage, the scenario's own problem last
+  std::vector<StageOutcome> stages;  ///< one per continuation stage, the scenario's own problem last
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
 };
 

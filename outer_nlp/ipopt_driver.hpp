@@ -33,6 +33,10 @@ struct IpoptOutcome;
 struct SolveTimings {
   double functions = 0.0, derivatives = 0.0, hessian = 0.0, total = 0.0;
   double ipopt() const { return total - functions - derivatives - hessian; }
+  SolveTimings& operator+=(const SolveTimings& o) {
+    functions += o.functions, derivatives += o.derivatives, hessian += o.hessian, total += o.total;
+    return *this;
+  }
 };
 
 struct IterationReport {

@@ -1,0 +1,78 @@
+#include "outer_nlp/motion_solve.hpp"
+
+#include <memory>
+
+#include "core/errors.hpp"
+
+namespace mcopt {
+
+MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
+                               const IpoptSettings& settings, const MotionSolveEvents& events) {
+  MotionSolveOutcome result;
+  Eigen::VectorXd x = x0;
+  const int stages = static_cast<int>(scenario.continuation.size()) + 1;
+  for (int k = 0; k < stages; ++k) {
+    const bool last = k + 1 == stages;
+    const Scenario stageScenario = continuationStage(scenario, static_cast<std::size_t>(k));
+    const std::unique_ptr<MotionProblem> stageProblem = last ? nullptr : std::make_unique<MotionProblem>(stageScenario);
+    MotionProblem& full = last ? problem : *stageProblem;
+    if (full.variableCount() != problem.variableCount())
+      throw InputError("continuation stage " + std::to_string(k + 1) +
+                       ": its samples change the per-sample variables (epigraph slacks, contact_forces: variables)");
+    std::vector<bool> omitted;
+    if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
+    StageOutcome stage;
+    stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
+    stage.smoothing = stageScenario.smoothing;
+    stage.samples = stageScenario.samples;
+    IpoptOutcome outcome;
+    int joined = 0;
+    for (;;) {
+      MotionProblem current(stageScenario, omitted);
+      stage.omittedTorqueRows = current.omittedTorqueRowCount();
+      if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
+      // A screening round starts at the previous round's optimum: a small barrier parameter
+      // keeps Ipopt near it instead of re-centring the iterate (ours first: the scenario's
+      // `solver` options still override it).
+      IpoptSettings roundSettings = settings;
+      if (stage.rounds > 0) {
+        SolverOption barrier;
+        barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = 1e-4;
+        barrier.text = "1e-4", barrier.origin = "torque-limit screening: ";
+        roundSettings.options.insert(roundSettings.options.begin(), barrier);
+      }
+      outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
+        return !events.onIteration || events.onIteration(k, current, r);
+      });
+      ++stage.rounds;
+      stage.iterations += outcome.iterations;
+      stage.seconds += outcome.seconds;
+      stage.timings += outcome.timings;
+      if (outcome.x.size() != x.size() || !outcome.x.allFinite() || !outcome.optimal() || omitted.empty()) break;
+      // Optimal for the rows in the problem, and for all of them when every omitted row is
+      // still below its fraction (then strictly inside its bound: multiplier 0).
+      const std::vector<bool> below = full.torquesBelow(outcome.x, scenario.torqueScreening);
+      joined = 0;
+      for (std::size_t i = 0; i < omitted.size(); ++i)
+        if (omitted[i] && !below[i]) omitted[i] = false, ++joined;
+      if (joined == 0) break;
+      x = outcome.x;
+    }
+    const bool usable = outcome.x.size() == x.size() && outcome.x.allFinite();
+    if (usable) x = outcome.x;
+    stage.status = outcome.status, stage.objective = outcome.objective;
+    result.stages.push_back(stage);
+    if (last || outcome.status == OuterStatus::Interrupted || !usable) {
+      result.solver = outcome;
+      if (!last) {
+        result.solver.x = x;  // the last usable iterate, of an earlier stage
+        result.reason = "stopped in continuation stage " + std::to_string(k + 1) + " of " + std::to_string(stages) +
+                        " (" + toString(outcome.status) + ")";
+      }
+      break;
+    }
+  }
+  return result;
+}
+
+}  // namespace mcopt

@@ -1,0 +1,55 @@
+#pragma once
+// A scenario's whole motion solve (docs/scenarios.md, "Continuation" and "Torque-limit
+// screening"): its continuation stages, each from the previous one's iterate, then its own
+// problem; every solve with the torque-limit rows below `limits.torque_screening` of their
+// limit left out and checked on its result, those that reached it joining for another solve.
+// The caller sees every solve start and every Ipopt iteration (progress, checkpoints, stop).
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/scenario.hpp"
+
+namespace mcopt {
+
+/// One continuation stage (the scenario's own problem last), over its screening rounds.
+struct StageOutcome {
+  double frictionSharpness = 0.0, smoothing = 0.0;
+  int samples = 0;
+  OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
+  double objective = 0.0;                           ///< of its last solve
+  int iterations = 0;                               ///< over its rounds
+  double seconds = 0.0;
+  SolveTimings timings;
+  int rounds = 0;             ///< solves: 1 + the times torque-limit rows joined
+  int omittedTorqueRows = 0;  ///< torque-limit rows out of the last solve, checked at its result
+};
+
+/// One Ipopt solve about to start.
+struct SolveStart {
+  int stage = 0, stages = 1;
+  const Scenario& scenario;      ///< the stage's scenario
+  const MotionProblem& problem;  ///< what Ipopt solves (the screened problem)
+  int joinedTorqueRows = 0;      ///< rows that joined since the previous round (0 on a stage's first)
+};
+
+struct MotionSolveEvents {
+  std::function<void(const SolveStart&)> onSolve;
+  /// Returns false to stop (Ipopt reports "interrupted").
+  std::function<bool(int stage, const MotionProblem& problem, const IterationReport&)> onIteration;
+};
+
+struct MotionSolveOutcome {
+  IpoptOutcome solver;              ///< the last solve's, with x the last usable iterate
+  std::vector<StageOutcome> stages;
+  std::string reason;               ///< why the solve ended before the scenario's own problem, if it did
+};
+
+/// `problem` is the scenario's own (full) motion problem; x0 its starting point.
+MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
+                               const IpoptSettings& settings, const MotionSolveEvents& events);
+
+}  // namespace mcopt
