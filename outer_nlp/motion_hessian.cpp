@@ -20,14 +20,12 @@
 
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_workspace.hpp"
+#include "outer_nlp/smooth_maximum.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
 namespace {
-
-/// P⁺ ≈ (P + sqrt(P² + ε²)) / 2: its slope (formulation.md §6).
-inline double smoothMaximumSlope(double p, double epsilon) { return 0.5 * (1.0 + p / std::sqrt(p * p + epsilon * epsilon)); }
 
 /// Forward-difference step for a variable of magnitude `value` (as the generic differences).
 inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }

@@ -12,6 +12,7 @@
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
+#include "outer_nlp/smooth_maximum.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
@@ -50,12 +51,6 @@ std::vector<double> sampleTimes(int count) {
   std::vector<double> u(static_cast<std::size_t>(count));
   for (int s = 0; s < count; ++s) u[static_cast<std::size_t>(s)] = static_cast<double>(s) / (count - 1);
   return u;
-}
-
-/// P⁺ ≈ (P + sqrt(P² + ε²)) / 2 and its derivative (formulation.md §6).
-inline double smoothMaximum(double p, double epsilon) { return 0.5 * (p + std::sqrt(p * p + epsilon * epsilon)); }
-inline double smoothMaximumSlope(double p, double epsilon) {
-  return 0.5 * (1.0 + p / std::sqrt(p * p + epsilon * epsilon));
 }
 
 /// The support contact is on the reference body: its frame never moves.

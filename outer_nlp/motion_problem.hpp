@@ -61,6 +61,7 @@ inline constexpr int kConstraintKindCount = 9;
 const char* constraintKindName(ConstraintKind kind);
 
 class BilevelSample;
+struct MotionWorkspace;  // outer_nlp/motion_workspace.hpp
 
 /// Everything a motion's samples say, for results (apps serialise it; nothing is re-evaluated there).
 struct SampledPhysics {
@@ -189,7 +190,7 @@ class MotionProblem final : public NlpProblem {
     Eigen::MatrixXd dyDz;          ///< rows × local force columns
     std::vector<int> forceColumns; ///< global variable of each local force column
   };
-  struct ThreadWorkspace;
+  using ThreadWorkspace = MotionWorkspace;
   /// A row of the registry: its kind, what `detail` says (joint, contact row, task
   /// component), the sample / task instant / velocity row it belongs to, and the output it reads.
   struct Row {

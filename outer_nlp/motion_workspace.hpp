@@ -1,17 +1,21 @@
 #pragma once
 // MotionProblem's per-thread evaluation buffers, shared by its evaluation
 // (motion_problem.cpp) and its Hessian (motion_hessian.cpp); not part of the interface.
+#include <Eigen/Core>
+#include <vector>
+
 #include "core/contact_maps.hpp"
 #include "core/dynamics_data.hpp"
 #include "core/dynamics_derivatives.hpp"
-#include "outer_nlp/motion_problem.hpp"
+#include "core/dynamics_model.hpp"
+#include "core/spatial.hpp"
 #include "outer_nlp/task_kinematics.hpp"
 
 namespace mcopt {
 
-/// Per-thread buffers, sized once (the per-sample path allocates nothing).
-struct MotionProblem::ThreadWorkspace {
-  ThreadWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
+/// MotionProblem's per-thread buffers, sized once (the per-sample path allocates nothing).
+struct MotionWorkspace {
+  MotionWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
     torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);

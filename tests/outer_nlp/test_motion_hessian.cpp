@@ -8,6 +8,7 @@
 #include <random>
 
 #include "common/finite_differences.hpp"
+#include "common/perturbed_motion.hpp"
 #include "common/test_support.hpp"
 #include "core/kinematics.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -65,14 +66,6 @@ Scenario kick(int samples) {
   return s;
 }
 
-Eigen::VectorXd perturbed(MotionProblem& problem, double size, unsigned seed) {
-  Eigen::VectorXd x = problem.initialPoint(problem.scenario().start, problem.scenario().end);
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> u(-size, size);
-  for (int i = 0; i < problem.parametrization().parameterCount(); ++i) x[i] += u(random);
-  for (int i = 0; i < problem.forceVariableCount(); ++i) x[problem.forceVariableStart() + i] += 20.0 * u(random);
-  return x;
-}
 
 }  // namespace
 
@@ -92,7 +85,7 @@ TEST_CASE("sample-differences Hessian: the kick against differences of the exact
     if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
     s.accelerationWeight = c.accelerationWeight;
     MotionProblem problem(s);
-    Eigen::VectorXd x = perturbed(problem, 0.05, 3);
+    Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 3);
     if (c.freeDuration) x[problem.parametrization().parameterCount()] = 1.5;
     double generic = 0.0;
     const double error = hessianError(problem, x, randomMultipliers(problem, 5), 0.8, &generic);
@@ -114,7 +107,7 @@ TEST_CASE("sample-differences Hessian: every contact-force formulation", "[outer
     s.contactForces = forces;
     s.hessian = HessianOption::SampleDifferences;
     MotionProblem problem(s);
-    const Eigen::VectorXd x = perturbed(problem, 0.02, 11);
+    const Eigen::VectorXd x = test::perturbedMotion(problem, 0.02, 11);
     double generic = 0.0;
     const double error = hessianError(problem, x, randomMultipliers(problem, 13), 1.0, &generic);
     INFO(toString(forces) << ": against central differences " << error << ", against the generic differences " << generic << "; infeasible samples "

@@ -8,6 +8,7 @@
 
 #include "common/finite_differences.hpp"
 #include "common/nlp_jacobian.hpp"
+#include "common/perturbed_motion.hpp"
 #include "common/test_support.hpp"
 #include "core/contact_maps.hpp"
 #include "core/trajectory_evaluation.hpp"
@@ -41,14 +42,6 @@ void addHandContact(Scenario& s, double start, double end) {
   s.contacts.push_back(hand);
 }
 
-Eigen::VectorXd perturbedMotion(MotionProblem& problem, double size, unsigned seed) {
-  Eigen::VectorXd x = problem.initialPoint(problem.scenario().start, problem.scenario().end);
-  std::mt19937 random(seed);
-  std::uniform_real_distribution<double> u(-size, size);
-  for (int i = 0; i < problem.parametrization().parameterCount(); ++i) x[i] += u(random);
-  for (int i = 0; i < problem.forceVariableCount(); ++i) x[problem.forceVariableStart() + i] += 20.0 * u(random);
-  return x;
-}
 
 }  // namespace
 
@@ -66,7 +59,7 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
         if (hand) addHandContact(s, 0.7, 1.7);  // starts and ends inside the motion
         if (freeDuration) s.duration.lower = 1.5, s.duration.upper = 3.0;
         MotionProblem problem(s);
-        Eigen::VectorXd x = perturbedMotion(problem, 0.05, 7);
+        Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 7);
         if (freeDuration) x[problem.parametrization().parameterCount()] = 2.2;
         const test::DerivativeErrors e = test::derivativeErrors(problem, x, 1e-6);
         INFO(toString(forces) << (hand ? ", three contacts" : ", two contacts") << (freeDuration ? ", free T" : "")
@@ -87,7 +80,7 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
   s.fixStart = s.fixEnd = false;
   s.duration.initial = s.duration.lower = s.duration.upper = 0.9;
   MotionProblem problem(s);
-  Eigen::VectorXd x = perturbedMotion(problem, 0.3, 11);
+  Eigen::VectorXd x = test::perturbedMotion(problem, 0.3, 11);
   Eigen::VectorXd g;
   problem.constraints(x, g);
   const int infeasible = problem.infeasibleSamples();
@@ -129,7 +122,7 @@ TEST_CASE("multi-contact outer problem: the contact wrenches balance W0 at every
     s.contactForces = forces;
     addHandContact(s, 0.5, 1.9);
     MotionProblem problem(s);
-    const Eigen::VectorXd x = perturbedMotion(problem, 0.02, 3);
+    const Eigen::VectorXd x = test::perturbedMotion(problem, 0.02, 3);
     const SampledPhysics physics = problem.sampledPhysics(x);
     const DynamicsModel& model = problem.model();
     DynamicsData data(model);

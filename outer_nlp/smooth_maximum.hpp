@@ -1,0 +1,13 @@
+#pragma once
+// The smooth maximum P⁺ ≈ (P + sqrt(P² + ε²)) / 2 of the energy criterion and its slope
+// (formulation.md §6): one definition for the objective, its gradient and its Hessian.
+#include <cmath>
+
+namespace mcopt {
+
+inline double smoothMaximum(double p, double epsilon) { return 0.5 * (p + std::sqrt(p * p + epsilon * epsilon)); }
+inline double smoothMaximumSlope(double p, double epsilon) {
+  return 0.5 * (1.0 + p / std::sqrt(p * p + epsilon * epsilon));
+}
+
+}  // namespace mcopt
