@@ -350,8 +350,9 @@ HessianOption parseHessianOption(const std::string& name) {
                    name + "'");
 }
 
-Scenario loadScenario(const std::filesystem::path& file) {
-  const YAML::Node root = yaml::loadFile(file);
+Scenario loadScenario(const std::filesystem::path& file) { return loadScenario(yaml::loadFile(file), file); }
+
+Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
   yaml::rejectUnknownKeys(file, root, "",
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",

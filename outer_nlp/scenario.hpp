@@ -5,6 +5,7 @@
 // validates everything and names file, line and field in every error.
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -15,6 +16,10 @@
 #include "core/robot_model.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
+
+namespace YAML {
+class Node;
+}
 
 namespace mcopt {
 
@@ -160,5 +165,12 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k);
 /// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints
 /// or postures, and impossible numbers.
 Scenario loadScenario(const std::filesystem::path& file);
+/// The same for a scenario already parsed (a study's case, docs/studies.md): `file` names it
+/// in messages, and its folder is where relative side-file paths start.
+Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file);
+
+/// The fields that name side files, relative to the scenario's folder: a copy of the scenario
+/// written elsewhere must make them absolute.
+inline constexpr std::array<const char*, 4> kScenarioSideFileFields = {"robot", "actuators", "contact_surfaces", "postures"};
 
 }  // namespace mcopt
