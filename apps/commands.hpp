@@ -14,5 +14,6 @@ Runner addDynamics(CLI::App& app);
 Runner addEvaluate(CLI::App& app);
 Runner addInner(CLI::App& app);
 Runner addRun(CLI::App& app);
+Runner addStudy(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(evaluate, mcopt::cli::addEvaluate(*evaluate));
   CLI::App* runCommand = app.add_subcommand("run", "optimise a motion from a scenario file with Ipopt");
   runners.emplace_back(runCommand, mcopt::cli::addRun(*runCommand));
+  CLI::App* study = app.add_subcommand("study", "sweeps of scenarios on a local process pool or as a Slurm job array");
+  runners.emplace_back(study, mcopt::cli::addStudy(*study));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {

@@ -13,6 +13,8 @@ packages=(
   catch2                   # Catch2 v2
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libbenchmark-dev         # Google Benchmark
+  python3-matplotlib       # study plots (scripts/plot_study.py)
+  slurm-wlm munge          # studies as Slurm job arrays; scripts/slurm-local.sh and its test
 )
 
 missing=()
