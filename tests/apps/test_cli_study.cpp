@@ -122,7 +122,7 @@ TEST_CASE("study: bad sweep files are refused with file, line and field, and not
   CHECK_THAT(r.errors, Contains("study.json") && Contains("no study here"));
 }
 
-TEST_CASE("study: the local pool runs every case; killed midway and started again, it runs only the unfinished ones", "[cli][study]") {
+TEST_CASE("study: the local pool runs every case, and killed midway and started again it runs only the unfinished ones", "[cli][study]") {
   if (kUnderSanitizers) return;  // ten optimisations: the Release build runs them
   const test::TempDir dir;
   const auto sweep = fourCaseSweep(dir);
@@ -193,7 +193,7 @@ TEST_CASE("study: a case past its time limit is stopped, keeps its last iterate 
 }
 
 #ifdef MCOPT_HAVE_SLURM
-TEST_CASE("study: a Slurm job array on a local cluster gives the local pool's cases; after scancel a restart runs only the unfinished ones",
+TEST_CASE("study: a Slurm job array on a local cluster gives the local pool's cases, and after scancel a restart runs only the unfinished ones",
           "[cli][study][slurm]") {
   if (kUnderSanitizers) return;
   if (::geteuid() != 0) {

@@ -100,7 +100,7 @@ TEST_CASE("URDF errors name the file and the element", "[input][urdf]") {
   }
 }
 
-TEST_CASE("fixed joints merge into their parent; massless links are fine", "[urdf]") {
+TEST_CASE("fixed joints merge into their parent, massless links are fine", "[urdf]") {
   const std::string xml = robot(urdfLink("base") + "<link name=\"frame\"/>" + urdfLink("tool") +
                                 "<joint name=\"f1\" type=\"fixed\"><parent link=\"base\"/><child link=\"frame\"/><origin xyz=\"0 0 1\"/></joint>"
                                 "<joint name=\"f2\" type=\"fixed\"><parent link=\"frame\"/><child link=\"tool\"/><origin xyz=\"1 0 0\"/></joint>");

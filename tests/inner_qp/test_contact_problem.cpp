@@ -42,7 +42,7 @@ double contactViolation(const ContactProblem& p, const Eigen::VectorXd& F) {
 
 }  // namespace
 
-TEST_CASE("objective is Σ w Γ² + l Γ with Γ = τ0 − J1 F; H and c are its quadratic form", "[inner]") {
+TEST_CASE("objective is Σ w Γ² + l Γ with Γ = τ0 − J1 F, H and c are its quadratic form", "[inner]") {
   std::mt19937 rng(3);
   const int n = 5;
   const Eigen::MatrixXd J1 = Eigen::MatrixXd::Random(n, 12);
