@@ -15,5 +15,6 @@ Runner addEvaluate(CLI::App& app);
 Runner addInner(CLI::App& app);
 Runner addRun(CLI::App& app);
 Runner addStudy(CLI::App& app);
+Runner addPlot(CLI::App& app);
 
 }  // namespace mcopt::cli

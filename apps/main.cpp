@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(runCommand, mcopt::cli::addRun(*runCommand));
   CLI::App* study = app.add_subcommand("study", "sweeps of scenarios on a local process pool or as a Slurm job array");
   runners.emplace_back(study, mcopt::cli::addStudy(*study));
+  CLI::App* plotCommand = app.add_subcommand("plot", "figures of an optimised motion (PNG and SVG, matplotlib)");
+  runners.emplace_back(plotCommand, mcopt::cli::addPlot(*plotCommand));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {

@@ -62,6 +62,16 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   const int m = problem.parametrization().parametersPerJoint();
   for (int j = 0; j < n; ++j) params[robot.joints[static_cast<std::size_t>(j)].name] = toJson(parameters.segment(j * m, m));
   result["parameters"] = params;
+  // The limits the problem holds the motion to, beside the motion (plots, checks by others).
+  Json lower = Json::array(), upper = Json::array(), velocity = Json::array(), torque = Json::array();
+  for (int j = 0; j < n; ++j) {
+    const auto u = static_cast<std::size_t>(j);
+    lower.push_back(numberOrNull(robot.joints[u].limits.lower));
+    upper.push_back(numberOrNull(robot.joints[u].limits.upper));
+    velocity.push_back(numberOrNull(scenario.actuators.joints[u].velocityLimit));
+    torque.push_back(numberOrNull(scenario.actuators.joints[u].torqueLimit));
+  }
+  result["joint_limits"] = {{"position_lower", lower}, {"position_upper", upper}, {"velocity", velocity}, {"torque", torque}};
   result["time"] = toJson(r.time);
   result["q"] = matrixToJson(r.q.transpose());
   result["v"] = matrixToJson(r.v.transpose());
@@ -74,6 +84,9 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
     Json contact;
     contact["name"] = r.contactNames[c];
     contact["reference"] = c == 0;
+    const ContactSurface& surface = c == 0 ? scenario.support : scenario.contacts[c - 1].surface;
+    contact["rectangle_m"] = {{"x", {surface.xMin, surface.xMax}}, {"y", {surface.yMin, surface.yMax}}};
+    contact["friction"] = surface.friction;
     Json active = Json::array(), wrench = Json::array(), copJson = Json::array();
     for (int s = 0; s < N; ++s) {
       const bool on = r.active[c][static_cast<std::size_t>(s)];

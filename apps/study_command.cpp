@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "apps/commands.hpp"
+#include "apps/python_script.hpp"
 #include "core/errors.hpp"
 #include "study/case_runner.hpp"
 #include "study/cases_table.hpp"
@@ -73,14 +74,6 @@ std::string reportText(const CaseReport& r) {
   return text.str();
 }
 
-/// Python with matplotlib: $MCOPT_PYTHON, else Debian's /usr/bin/python3 (where
-/// python3-matplotlib installs), else python3 on PATH.
-std::string python() {
-  if (const char* chosen = std::getenv("MCOPT_PYTHON"); chosen && *chosen) return chosen;
-  if (::access("/usr/bin/python3", X_OK) == 0) return "/usr/bin/python3";
-  return "python3";
-}
-
 /// Writes cases.csv and, unless told not to, the plots; prints a line a case. Returns the
 /// number of unfinished cases, or -1 when the plots could not be drawn.
 int collect(const StudyFolder& folder, bool plots) {
@@ -94,11 +87,9 @@ int collect(const StudyFolder& folder, bool plots) {
   std::cout << "cases: " << folder.casesCsv().string() << " (" << reports.size() - static_cast<std::size_t>(unfinished)
             << " of " << reports.size() << " finished)\n";
   if (!plots) return unfinished;
-  const std::filesystem::path script = std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / "plot_study.py";
-  const auto [exit, output] = runAndCapture({python(), script.string(), folder.casesCsv().string(), (folder.root() / "plots").string()});
+  const auto [exit, output] = runPythonScript("plot_study.py", {folder.casesCsv().string(), (folder.root() / "plots").string()});
   if (!exit.exited || exit.code != 0) {
-    std::cerr << "mcopt: error: the plots were not drawn (" << python() << " " << script.string()
-              << " ended with code " << exit.code << "; it needs matplotlib: Debian's python3-matplotlib, or set MCOPT_PYTHON)\n";
+    std::cerr << "mcopt: error: the plots were not drawn (" << pythonFailure("plot_study.py", exit) << ")\n";
     return -1;
   }
   std::cout << "plots: " << (folder.root() / "plots").string() << "/energy_vs_*.png, .svg\n";

@@ -1,0 +1,27 @@
+#include "apps/python_script.hpp"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace mcopt::cli {
+
+std::string pythonInterpreter() {
+  if (const char* chosen = std::getenv("MCOPT_PYTHON"); chosen && *chosen) return chosen;
+  if (::access("/usr/bin/python3", X_OK) == 0) return "/usr/bin/python3";
+  return "python3";
+}
+
+std::pair<study::ChildExit, std::string> runPythonScript(const std::string& name, const std::vector<std::string>& arguments) {
+  std::vector<std::string> command = {pythonInterpreter(), (std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / name).string()};
+  command.insert(command.end(), arguments.begin(), arguments.end());
+  return study::runAndCapture(command);
+}
+
+std::string pythonFailure(const std::string& name, const study::ChildExit& exit) {
+  return pythonInterpreter() + " scripts/" + name + (exit.exited ? " ended with code " + std::to_string(exit.code) : " died of signal " + std::to_string(exit.signal)) +
+         "; it needs matplotlib: Debian's python3-matplotlib, or Python with matplotlib in $MCOPT_PYTHON";
+}
+
+}  // namespace mcopt::cli
