@@ -214,3 +214,21 @@ TEST_CASE("study: the folder refuses another study and reports each case's state
   CHECK(row0 == "0,10,maximum_iterations,1.5,9.9999999999999995e-08,20,2,node1");
   CHECK(row1 == "1,12,cancelled,3,,,,node2");
 }
+
+TEST_CASE("study: the inner solver and the contact-force formulation vary like any field", "[study]") {
+  const test::TempDir dir;
+  const auto file = dir.write("sweep.yaml", "scenario: " + (test::sourceDir() / "scenarios/hrp2_weight_shift.yaml").string() +
+                                                "\nvary:\n  - {field: contact_forces, values: [bilevel, splines]}\n"
+                                                "  - {field: inner.solver, values: [active-set, slsqp, ipopt]}\n");
+  const Sweep sweep = loadSweep(file);
+  const std::vector<StudyCase> cases = designCases(sweep);
+  REQUIRE(cases.size() == 6);
+  CHECK(cases[4].scenario["contact_forces"].as<std::string>() == "splines");
+  CHECK(cases[4].scenario["inner"]["solver"].as<std::string>() == "slsqp");
+  CHECK(cases[4].scenario["inner"]["contact_model"].as<std::string>() == "report");  // the rest of `inner` kept
+  REQUIRE_NOTHROW(validateCases(sweep, cases));
+  const auto bad = dir.write("bad.yaml", "scenario: " + (test::sourceDir() / "scenarios/hrp2_weight_shift.yaml").string() +
+                                             "\nvary:\n  - {field: inner.solver, values: [active-set, cplex]}\n");
+  const Sweep badSweep = loadSweep(bad);
+  CHECK_THROWS_WITH(validateCases(badSweep, designCases(badSweep)), Contains("bad.yaml:3: vary[0].values[1]: inner.solver = cplex: the scenario refuses it: inner.solver:"));
+}
