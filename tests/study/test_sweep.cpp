@@ -1,5 +1,8 @@
 // Sweeps (docs/studies.md): field paths, the three designs, validation of every case by the
 // scenario loader with errors at the sweep's own lines, array ranges, the study folder.
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <set>
@@ -7,6 +10,7 @@
 #include "common/temp_dir.hpp"
 #include "common/test_support.hpp"
 #include "core/errors.hpp"
+#include "study/case_runner.hpp"
 #include "study/cases_table.hpp"
 #include "study/field_path.hpp"
 #include "study/slurm_array.hpp"
@@ -231,4 +235,27 @@ TEST_CASE("study: the inner solver and the contact-force formulation vary like a
                                              "\nvary:\n  - {field: inner.solver, values: [active-set, cplex]}\n");
   const Sweep badSweep = loadSweep(bad);
   CHECK_THROWS_WITH(validateCases(badSweep, designCases(badSweep)), Contains("bad.yaml:3: vary[0].values[1]: inner.solver = cplex: the scenario refuses it: inner.solver:"));
+}
+
+TEST_CASE("study: an attempt whose runner is alive on this host is still running, one whose runner died is not", "[study]") {
+  char host[256] = {};
+  ::gethostname(host, sizeof host - 1);
+  CaseRecord alive;
+  alive.host = host;
+  alive.pid = ::getppid();  // the process that started this test: alive while it runs
+  CHECK(attemptStillRunning(alive));
+  CaseRecord ended = alive;
+  ended.end = "completed";
+  CHECK_FALSE(attemptStillRunning(ended));
+  CaseRecord elsewhere = alive;
+  elsewhere.host = std::string(host) + "-another";
+  CHECK_FALSE(attemptStillRunning(elsewhere));  // without Slurm, another host's record cannot be checked: stale
+  // A runner that has exited: its pid, reaped, names no process.
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  CaseRecord dead = alive;
+  dead.pid = child;
+  CHECK_FALSE(attemptStillRunning(dead));
 }
