@@ -7,13 +7,14 @@
 #   scripts/slurm-local.sh stop  [DIR]   stop its daemons (the folder stays, with their logs)
 #   scripts/slurm-local.sh status [DIR]  sinfo of the cluster, or exit 1 when it is down
 #
-# DIR defaults to $MCOPT_SLURM_DIR, else /tmp/mcopt-slurm. The ports are the first free pair
+# DIR defaults to $MCOPT_SLURM_DIR, else build/slurm-local in this checkout. The ports are the first free pair
 # from 16817 (two clusters in two folders can run side by side). Needs root (slurmd starts
 # jobs as their user) — the CI machine and this project's workplace are root.
 set -euo pipefail
 
 action="${1:-}"
-dir="${2:-${MCOPT_SLURM_DIR:-/tmp/mcopt-slurm}}"
+root="$(cd "$(dirname "$0")/.." && pwd)"
+dir="${2:-${MCOPT_SLURM_DIR:-$root/build/slurm-local}}"
 case "$action" in start|stop|status) ;; *) echo "usage: $0 start|stop|status [DIR]" >&2; exit 2 ;; esac
 mkdir -p "$dir"
 dir="$(cd "$dir" && pwd)"
