@@ -136,10 +136,10 @@ def power_figure(result, out, written):
     ax.legend(fontsize=7, ncol=3)
     ax.set_title("power (a limb's joints share its colour)")
     # ∫ Σ max(P, 0) dt by trapezoids: the energy result.json reports (over its samples).
+    positive = [sum(max(p, 0.0) for p in row) for row in power]
     energy, cumulative = 0.0, [0.0]
     for s in range(1, len(time)):
-        positive = lambda row: sum(max(p, 0.0) for p in row)  # noqa: E731
-        energy += 0.5 * (positive(power[s - 1]) + positive(power[s])) * (time[s] - time[s - 1])
+        energy += 0.5 * (positive[s - 1] + positive[s]) * (time[s] - time[s - 1])
         cumulative.append(energy)
     ax_energy.plot(time, cumulative, color="tab:red")
     ax_energy.set_xlabel("time [s]")
