@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -39,6 +40,26 @@ inline Eigen::VectorXd numbers(const std::filesystem::path& file, const Json& no
       throw InputError(file.string() + ": " + field + "[" + std::to_string(i) + "]: not a finite number");
   }
   return v;
+}
+
+/// Refuses keys of `node` (an object) that are not in `keys`, naming the field.
+inline void allowKeys(const std::filesystem::path& file, const Json& node, const std::string& field,
+               std::initializer_list<const char*> keys) {
+  if (!node.is_object()) throw InputError(file.string() + ": " + field + ": expected an object");
+  for (const auto& [key, value] : node.items()) {
+    bool known = false;
+    for (const char* k : keys) known |= key == k;
+    if (known) continue;
+    std::string list;
+    for (const char* k : keys) list += (list.empty() ? "" : ", ") + std::string(k);
+    throw InputError(file.string() + ": " + field + "." + key + ": unknown key (expected " + list + ")");
+  }
+}
+
+/// The member `key` of `node`, or an error naming the field.
+inline const Json& required(const std::filesystem::path& file, const Json& node, const std::string& field, const char* key) {
+  if (!node.contains(key)) throw InputError(file.string() + ": " + field + ": missing '" + key + "'");
+  return node[key];
 }
 
 inline Json toJson(const Eigen::Ref<const Eigen::VectorXd>& v) {

@@ -4,6 +4,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
+#include "apps/robot_info_json.hpp"
 #include "core/actuators.hpp"
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
@@ -16,17 +17,6 @@ struct RobotInfoOptions {
   std::string robot, actuators;
   bool json = false, allowNonPhysicalInertia = false;
 };
-
-json_io::Json finiteOrNull(double value) { return std::isfinite(value) ? json_io::Json(value) : json_io::Json(); }
-
-const char* typeName(JointType type) {
-  switch (type) {
-    case JointType::Revolute: return "revolute";
-    case JointType::Continuous: return "continuous";
-    case JointType::Prismatic: return "prismatic";
-  }
-  return "?";
-}
 
 int runRobotInfo(const RobotInfoOptions& o) {
   const RobotModel robot = loadUrdfFile(o.robot, {o.allowNonPhysicalInertia});
@@ -42,35 +32,7 @@ int runRobotInfo(const RobotInfoOptions& o) {
   auto velocity = [&](int j) { return actuators.joints[j].velocityLimit; };
 
   if (o.json) {
-    json_io::Json out;
-    out["name"] = robot.name;
-    out["source"] = robot.source;
-    out["total_mass"] = robot.totalMass();
-    out["com"] = json_io::toJson(Eigen::VectorXd(com));
-    out["root"] = robot.frames[0].name;
-    out["joints"] = json_io::Json::array();
-    for (int j = 0; j < robot.jointCount(); ++j) {
-      const Joint& joint = robot.joints[j];
-      const ActuatorParameters& a = actuators.joints[j];
-      out["joints"].push_back({{"name", joint.name},
-                               {"type", typeName(joint.type)},
-                               {"parent", robot.bodies[joint.parentBody].name},
-                               {"child", robot.bodies[joint.childBody].name},
-                               {"lower", finiteOrNull(joint.limits.lower)},
-                               {"upper", finiteOrNull(joint.limits.upper)},
-                               {"velocity", finiteOrNull(velocity(j))},
-                               {"effort", finiteOrNull(effort(j))},
-                               {"gear_ratio", a.gearRatio},
-                               {"torque_constant", a.torqueConstant},
-                               {"resistance", a.resistance}});
-    }
-    out["bodies"] = json_io::Json::array();
-    for (const Body& body : robot.bodies)
-      out["bodies"].push_back({{"name", body.name}, {"mass", body.inertia.mass}});
-    out["frames"] = json_io::Json::array();
-    for (const Frame& frame : robot.frames) out["frames"].push_back(frame.name);
-    out["warnings"] = robot.warnings;
-    std::cout << out.dump(2) << "\n";
+    std::cout << robotInfoJson(robot, actuators).dump(2) << "\n";
     return 0;
   }
   std::cout << "robot " << robot.name << " (" << robot.source << ")\n"

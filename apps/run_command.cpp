@@ -6,7 +6,6 @@
 // the current iterate is written every --checkpoint-seconds with status "running", so that
 // a run killed outright (SIGKILL, power loss) still leaves its latest complete result.
 #include <atomic>
-#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <iomanip>
@@ -14,10 +13,10 @@
 
 #include "apps/commands.hpp"
 #include "apps/run_output.hpp"
-#include "outer_nlp/configuration_problem.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
+#include "outer_nlp/scenario_run.hpp"
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt::cli {
@@ -37,34 +36,6 @@ struct RunOptions {
 
 constexpr int kExitNotOptimal = 4;
 constexpr int kExitInterrupted = 130;
-
-double seconds(std::chrono::steady_clock::time_point since) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-/// Configuration optimisation of one end of the motion; returns the posture to start from.
-Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& motion, const Eigen::VectorXd& guess,
-                                double instant, const char* which, PostureOutcome& outcome) {
-  ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant);
-  outcome.optimised = true;
-  outcome.staticPowerBefore = problem.staticPower(guess);
-  IpoptSettings settings;
-  SolverOption iterations;
-  iterations.name = "max_iter", iterations.type = SolverOption::Type::Integer;
-  iterations.integer = scenario.configurationIterations, iterations.origin = "initialisation.configuration_iterations: ";
-  settings.options = {iterations};
-  const IpoptOutcome result =
-      solveWithIpopt(problem, guess, settings, [](const IterationReport&) { return stopRequested == 0; });
-  outcome.status = result.status;
-  outcome.iterations = result.iterations;
-  outcome.seconds = result.seconds;
-  const bool usable = result.x.size() == guess.size() && result.x.allFinite();
-  outcome.staticPowerAfter = usable ? problem.staticPower(result.x) : outcome.staticPowerBefore;
-  std::cout << "  " << which << " posture: " << toString(result.status) << " after " << result.iterations
-            << " iterations, static power " << std::setprecision(4) << outcome.staticPowerBefore << " → "
-            << outcome.staticPowerAfter << " W (" << std::setprecision(3) << result.seconds << " s)\n";
-  return usable ? result.x : guess;
-}
 
 /// The run so far, written as its result with status "running": what a killed run leaves.
 /// A failed write costs the checkpoint, not the run (it is reported and Ipopt goes on).
@@ -91,17 +62,8 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 }
 
 int runMotion(const RunOptions& o) {
-  const auto clock = std::chrono::steady_clock::now();
   Scenario scenario = loadScenario(o.scenario);
-  if (o.configurationOptimisation == "on") scenario.configurationOptimisation = true;
-  if (o.configurationOptimisation == "off") scenario.configurationOptimisation = false;
-  if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
-  if (o.maxIterations >= 0) {
-    SolverOption limit;
-    limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
-    limit.origin = "--max-iterations: ";
-    scenario.solverOptions.push_back(limit);
-  }
+  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations});
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   MotionProblem problem(scenario);
   std::cout << "mcopt run " << o.scenario << "\n";
@@ -124,23 +86,14 @@ int runMotion(const RunOptions& o) {
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
 
-  RunRecord record;
-  Eigen::VectorXd start = scenario.start, end = scenario.end;
-  const auto configurationClock = std::chrono::steady_clock::now();
-  if (scenario.configurationOptimisation) {
-    std::cout << "configuration optimisation (report §3.5)\n";
-    if (!scenario.fixStart) start = optimisePosture(scenario, problem, start, 0.0, "start", record.start);
-    if (!scenario.fixEnd) end = optimisePosture(scenario, problem, end, scenario.duration.initial, "end", record.end);
-  }
-  record.configurationSeconds = seconds(configurationClock);
-
-  const Eigen::VectorXd x0 = problem.initialPoint(start, end);
-  IpoptSettings settings;
-  settings.options = scenario.solverOptions;
-  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
-  const auto optimisationClock = std::chrono::steady_clock::now();
+  if (scenario.configurationOptimisation) std::cout << "configuration optimisation (report §3.5)\n";
   double lastCheckpoint = 0.0;
-  MotionSolveEvents events;
+  ScenarioRunEvents events;
+  events.onPosture = [](const std::string& which, const PostureOutcome& p) {
+    std::cout << "  " << which << " posture: " << toString(p.status) << " after " << p.iterations
+              << " iterations, static power " << std::setprecision(4) << p.staticPowerBefore << " → "
+              << p.staticPowerAfter << " W (" << std::setprecision(3) << p.seconds << " s)\n";
+  };
   events.onSolve = [&](const SolveStart& solve) {
     if (solve.joinedTorqueRows > 0)
       std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.torqueScreening
@@ -160,38 +113,24 @@ int runMotion(const RunOptions& o) {
               << (solve.problem.bilevel() ? "   infeasible samples" : "") << "\n";
     lastCheckpoint = 0.0;
   };
-  events.onIteration = [&](int stage, const MotionProblem& current, const IterationReport& r) {
+  events.onIteration = [&](const RunRecord& sofar, const MotionProblem& current, const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
-    const MotionProblem::InnerStatistics inner = current.innerStatistics();
-    if (current.bilevel()) std::printf("   %d", inner.infeasible);
+    if (current.bilevel()) std::printf("   %d", sofar.history.back().inner.infeasible);
     std::printf("\n");
-    record.history.push_back({stage, r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds,
-                              r.stepSize, r.regularisation, r.barrier, r.timings, inner});
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
         r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
-      writeCheckpoint(o.out, problem, record, r, seconds(optimisationClock), seconds(clock));
+      writeCheckpoint(o.out, problem, sofar, r, sofar.optimisationSeconds, sofar.totalSeconds);
       lastCheckpoint = r.elapsedSeconds;
     }
-    return stopRequested == 0;
+    return true;
   };
-  MotionSolveOutcome solved = solveMotion(scenario, problem, x0, settings, events);
-  record.solver = std::move(solved.solver);
-  record.stages = std::move(solved.stages);
-  record.reason = solved.reason;
-  record.optimisationSeconds = seconds(optimisationClock);
+  events.keepRunning = [] { return stopRequested == 0; };
+  RunRecord record = runScenario(scenario, problem, events);
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-
-  record.status = record.solver.status;
-  record.message = record.solver.message;
-  record.x = record.solver.x.size() == x0.size() && record.solver.x.allFinite() ? record.solver.x : x0;
-  if (record.solver.x.size() != x0.size()) record.reason = "Ipopt returned no iterate; the initial motion is written";
-  if (!record.solver.evaluationError.empty() && record.reason.empty()) record.reason = "evaluation failed: " + record.solver.evaluationError;
   if (record.status == OuterStatus::Interrupted) record.reason = "interrupted by a signal; the last iterate is written";
-  else if (!record.solver.optimal() && record.reason.empty()) record.reason = "Ipopt: " + record.solver.message;
-  record.totalSeconds = seconds(clock);
   const auto [energy, violation] = writeRunOutput(o.out, problem, record);
 
   std::cout << "\nEXIT: " << record.message << "\n"

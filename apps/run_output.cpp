@@ -32,8 +32,7 @@ Json numberOrNull(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr);
 
 }  // namespace
 
-std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
-                                         const RunRecord& record) {
+RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
   const Scenario& scenario = problem.scenario();
   const RobotModel& robot = scenario.robot;
   const Eigen::VectorXd parameters = problem.motionParameters(record.x);
@@ -44,7 +43,8 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
   const int N = static_cast<int>(r.time.size());
   const bool fine = r.fineTime.size() > 0;
 
-  Json result;
+  RunFiles files;
+  Json& result = files.result;
   result["status"] = toString(record.status);
   result["energy"] = r.energy;
   result["max_violation"] = violations.overall;
@@ -199,7 +199,7 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
                        {"optimisation_split", split(all, SolveTimings{})}};
 
   // The states as a `mcopt dynamics` input: re-evaluating them reproduces `torques`.
-  Json states;
+  Json& states = files.states;
   states["joint_names"] = robot.jointNames();
   states["gravity"] = toJson(scenario.gravity);
   const RigidTransform& pose = problem.model().referencePose();
@@ -211,7 +211,7 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
 
   // The contact wrenches as a `mcopt dynamics --contacts` input: with states.json it
   // reproduces `torques` (Γ = Γ0 − J1 F).
-  Json wrenchFile;
+  Json& wrenchFile = files.contactWrenches;
   wrenchFile["contact_surfaces"] = std::filesystem::absolute(scenario.contactSurfacesFile).lexically_normal().string();
   wrenchFile["contacts"] = Json::array();
   for (std::size_t c = 0; c < r.contactNames.size(); ++c) {
@@ -250,14 +250,28 @@ std::pair<double, double> writeRunOutput(const std::filesystem::path& directory,
     fineCsv << "\n";
   }
 
+  files.trajectoryCsv = csv.str();
+  files.powerFineCsv = fineCsv.str();
+  files.energy = r.energy;
+  files.maxViolation = violations.overall;
+  return files;
+}
+
+void writeRunFiles(const std::filesystem::path& directory, const RunFiles& files) {
   std::filesystem::create_directories(directory);
-  writeFileAtomically(directory / "trajectory.csv", csv.str());
-  writeFileAtomically(directory / "power_fine.csv", fineCsv.str());
-  writeFileAtomically(directory / "states.json", states.dump(1) + "\n");
-  writeFileAtomically(directory / "contact_wrenches.json", wrenchFile.dump(1) + "\n");
+  writeFileAtomically(directory / "trajectory.csv", files.trajectoryCsv);
+  writeFileAtomically(directory / "power_fine.csv", files.powerFineCsv);
+  writeFileAtomically(directory / "states.json", files.states.dump(1) + "\n");
+  writeFileAtomically(directory / "contact_wrenches.json", files.contactWrenches.dump(1) + "\n");
   // result.json last: once it names this run, the other files are this run's too.
-  writeFileAtomically(directory / "result.json", result.dump(1) + "\n");
-  return {r.energy, violations.overall};
+  writeFileAtomically(directory / "result.json", files.result.dump(1) + "\n");
+}
+
+std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
+                                         const RunRecord& record) {
+  const RunFiles files = makeRunFiles(problem, record);
+  writeRunFiles(directory, files);
+  return {files.energy, files.maxViolation};
 }
 
 }  // namespace mcopt::cli

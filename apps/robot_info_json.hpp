@@ -1,0 +1,14 @@
+#pragma once
+// A robot description as JSON (`mcopt robot info --json`, and `Robot.info()` in Python):
+// name, source, mass, centre of mass at the zero posture, joints with their limits and
+// actuator parameters (actuator file over URDF, formulation.md §2), bodies, frames, warnings.
+
+#include "apps/json_io.hpp"
+#include "core/actuators.hpp"
+#include "core/robot_model.hpp"
+
+namespace mcopt::cli {
+
+json_io::Json robotInfoJson(const RobotModel& robot, const ActuatorSet& actuators);
+
+}  // namespace mcopt::cli

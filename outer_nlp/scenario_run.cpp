@@ -1,0 +1,109 @@
+#include "outer_nlp/scenario_run.hpp"
+
+#include <chrono>
+
+#include "core/errors.hpp"
+#include "outer_nlp/configuration_problem.hpp"
+
+namespace mcopt {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// Configuration optimisation of one end of the motion (report §3.5); returns the posture to
+/// start from (the guess when Ipopt handed back nothing usable).
+Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& motion, const Eigen::VectorXd& guess,
+                                double instant, const ScenarioRunEvents& events, PostureOutcome& outcome) {
+  ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant);
+  outcome.optimised = true;
+  outcome.staticPowerBefore = problem.staticPower(guess);
+  IpoptSettings settings;
+  SolverOption iterations;
+  iterations.name = "max_iter", iterations.type = SolverOption::Type::Integer;
+  iterations.integer = scenario.configurationIterations, iterations.origin = "initialisation.configuration_iterations: ";
+  settings.options = {iterations};
+  const IpoptOutcome result = solveWithIpopt(problem, guess, settings, [&](const IterationReport&) {
+    return !events.keepRunning || events.keepRunning();
+  });
+  outcome.status = result.status;
+  outcome.iterations = result.iterations;
+  outcome.seconds = result.seconds;
+  const bool usable = result.x.size() == guess.size() && result.x.allFinite();
+  outcome.staticPowerAfter = usable ? problem.staticPower(result.x) : outcome.staticPowerBefore;
+  return usable ? result.x : guess;
+}
+
+}  // namespace
+
+void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
+  if (o.configurationOptimisation == "on")
+    scenario.configurationOptimisation = true;
+  else if (o.configurationOptimisation == "off")
+    scenario.configurationOptimisation = false;
+  else if (!o.configurationOptimisation.empty())
+    throw InputError("configuration_optimisation: expected on or off, got '" + o.configurationOptimisation + "'");
+  if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
+  if (o.maxIterations >= 0) {
+    SolverOption limit;
+    limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
+    limit.origin = "--max-iterations: ";
+    scenario.solverOptions.push_back(limit);
+  }
+}
+
+RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events) {
+  const auto clock = std::chrono::steady_clock::now();
+  RunRecord record;
+  Eigen::VectorXd start = scenario.start, end = scenario.end;
+  if (scenario.configurationOptimisation) {
+    if (!scenario.fixStart) {
+      start = optimisePosture(scenario, problem, start, 0.0, events, record.start);
+      if (events.onPosture) events.onPosture("start", record.start);
+    }
+    if (!scenario.fixEnd) {
+      end = optimisePosture(scenario, problem, end, scenario.duration.initial, events, record.end);
+      if (events.onPosture) events.onPosture("end", record.end);
+    }
+  }
+  record.configurationSeconds = secondsSince(clock);
+
+  const Eigen::VectorXd x0 = problem.initialPoint(start, end);
+  IpoptSettings settings;
+  settings.options = scenario.solverOptions;
+  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
+  const auto optimisationClock = std::chrono::steady_clock::now();
+  MotionSolveEvents solveEvents;
+  solveEvents.onSolve = events.onSolve;
+  solveEvents.onIteration = [&](int stage, const MotionProblem& current, const IterationReport& r) {
+    record.history.push_back({stage, r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds,
+                              r.stepSize, r.regularisation, r.barrier, r.timings, current.innerStatistics()});
+    record.optimisationSeconds = secondsSince(optimisationClock);
+    record.totalSeconds = secondsSince(clock);
+    bool go = !events.onIteration || events.onIteration(record, current, r);
+    if (go && events.keepRunning) go = events.keepRunning();
+    return go;
+  };
+  MotionSolveOutcome solved = solveMotion(scenario, problem, x0, settings, solveEvents);
+  record.solver = std::move(solved.solver);
+  record.stages = std::move(solved.stages);
+  record.reason = solved.reason;
+  record.optimisationSeconds = secondsSince(optimisationClock);
+
+  record.status = record.solver.status;
+  record.message = record.solver.message;
+  record.x = record.solver.x.size() == x0.size() && record.solver.x.allFinite() ? record.solver.x : x0;
+  if (record.solver.x.size() != x0.size()) record.reason = "Ipopt returned no iterate; the initial motion is written";
+  if (!record.solver.evaluationError.empty() && record.reason.empty())
+    record.reason = "evaluation failed: " + record.solver.evaluationError;
+  if (record.status == OuterStatus::Interrupted)
+    record.reason = "interrupted; the last iterate is written";
+  else if (!record.solver.optimal() && record.reason.empty())
+    record.reason = "Ipopt: " + record.solver.message;
+  record.totalSeconds = secondsSince(clock);
+  return record;
+}
+
+}  // namespace mcopt

@@ -1,0 +1,75 @@
+#pragma once
+// A scenario's whole run (docs/scenarios.md): the optional configuration optimisation of its
+// end postures (report §3.5), then the motion solve with its continuation stages and
+// torque-limit screening (motion_solve.hpp), gathered into one RunRecord. The command line
+// (`mcopt run`) and the Python module both run scenarios through here and only differ in
+// how they show progress, how a stop is asked for and what they do with the record.
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/motion_solve.hpp"
+#include "outer_nlp/scenario.hpp"
+
+namespace mcopt {
+
+/// Run-time changes to a scenario (`mcopt run` options, keyword arguments in Python).
+struct ScenarioOverrides {
+  std::string configurationOptimisation;  ///< "", "on" or "off"
+  std::string contactForces;              ///< "", or a formulation name (formulation.md §9)
+  int maxIterations = -1;                 ///< Ipopt's max_iter for the motion; < 0: the scenario's
+};
+
+/// Applies the overrides; throws InputError for a value that is not one of the choices.
+void applyOverrides(Scenario& scenario, const ScenarioOverrides& overrides);
+
+/// One static posture found by configuration optimisation (report §3.5).
+struct PostureOutcome {
+  bool optimised = false;
+  OuterStatus status = OuterStatus::InternalError;
+  double staticPowerBefore = 0.0, staticPowerAfter = 0.0;  ///< [W]
+  int iterations = 0;
+  double seconds = 0.0;
+};
+
+/// One Ipopt iteration of the motion solve, with the bilevel inner problems of the last
+/// evaluation before it (result.json `history`).
+struct IterationRecord {
+  int stage = 0;  ///< continuation stage (0 without continuation)
+  int iteration = 0;
+  double objective = 0.0, violation = 0.0, dualInfeasibility = 0.0, elapsedSeconds = 0.0;
+  double stepSize = 0.0, regularisation = 0.0, barrier = 0.0;  ///< Ipopt's α_pr, δ_w and μ
+  SolveTimings timings;  ///< cumulative up to this iteration
+  MotionProblem::InnerStatistics inner;
+};
+
+struct RunRecord {
+  OuterStatus status = OuterStatus::InternalError;
+  std::string message, reason;  ///< reason: why a run that is not optimal ended
+  Eigen::VectorXd x;            ///< the outer problem's variables (the last usable iterate)
+  PostureOutcome start, end;
+  IpoptOutcome solver;
+  std::vector<IterationRecord> history;
+  std::vector<StageOutcome> stages;  ///< one per continuation stage, the scenario's own problem last
+  double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
+};
+
+struct ScenarioRunEvents {
+  /// A start or end posture has been optimised ("start" or "end").
+  std::function<void(const std::string& which, const PostureOutcome&)> onPosture;
+  std::function<void(const SolveStart&)> onSolve;
+  /// After each motion iteration, once its record has joined `sofar.history`; false stops.
+  std::function<bool(const RunRecord& sofar, const MotionProblem& current, const IterationReport&)> onIteration;
+  /// Asked at every Ipopt iteration of every solve (postures included); false stops, and
+  /// the run ends with status `interrupted` and its last iterate.
+  std::function<bool()> keepRunning;
+};
+
+/// Runs `scenario` on its own motion problem `problem` (built from it). Never throws for a
+/// numerical outcome (that is the record's status); throws InputError for what Ipopt refuses.
+RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events);
+
+}  // namespace mcopt
