@@ -13,7 +13,8 @@ packages=(
   catch2                   # Catch2 v2
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libbenchmark-dev         # Google Benchmark
-  python3-matplotlib       # study plots (scripts/plot_study.py)
+  python3-matplotlib       # plots (scripts/plot_*.py) and the Python example
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (docs/python.md) and its tests
   slurm-wlm munge          # studies as Slurm job arrays; scripts/slurm-local.sh and its test
 )
 

@@ -120,4 +120,36 @@ void setField(YAML::Node root, const FieldPath& path, const YAML::Node& value) {
   }
 }
 
+YAML::Node getField(const YAML::Node& root, const FieldPath& path) {
+  YAML::Node node = YAML::Clone(root);
+  for (std::size_t k = 0; k < path.steps.size(); ++k) {
+    const FieldPathStep& step = path.steps[k];
+    YAML::Node next;
+    if (step.kind == FieldPathStep::Kind::Key) {
+      if (!node.IsMap()) throw std::invalid_argument("'" + prefix(path, k) + "' is not a mapping: it has no field '" + step.key + "'");
+      if (!node[step.key]) throw std::invalid_argument("'" + prefix(path, k + 1) + "' is not set");
+      next.reset(node[step.key]);
+    } else {
+      if (!node.IsSequence()) throw std::invalid_argument("'" + prefix(path, k) + "' is not a list");
+      std::size_t found = node.size();
+      if (step.kind == FieldPathStep::Kind::Index) {
+        found = step.index;
+        if (found >= node.size())
+          throw std::invalid_argument("'" + prefix(path, k) + "' has " + std::to_string(node.size()) + " elements: no [" +
+                                      std::to_string(step.index) + "]");
+      } else {
+        for (std::size_t e = 0; e < node.size(); ++e)
+          if (node[e].IsMap() && node[e]["name"] && node[e]["name"].IsScalar() && node[e]["name"].Scalar() == step.key) {
+            found = e;
+            break;
+          }
+        if (found == node.size()) throw std::invalid_argument("'" + prefix(path, k) + "' has no element named '" + step.key + "'");
+      }
+      next.reset(node[found]);
+    }
+    node.reset(next);
+  }
+  return node;
+}
+
 }  // namespace mcopt::study

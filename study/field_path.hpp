@@ -33,4 +33,8 @@ FieldPath parseFieldPath(const std::string& text);
 /// the scenario's own validation (loadScenario), not here.
 void setField(YAML::Node root, const FieldPath& path, const YAML::Node& value);
 
+/// The field of `root` at `path` (a copy). A missing key, an index out of range, a name no
+/// element has or a step into a scalar throws std::invalid_argument naming the step.
+YAML::Node getField(const YAML::Node& root, const FieldPath& path);
+
 }  // namespace mcopt::study

@@ -1,0 +1,262 @@
+// mcopt.Scenario: a scenario file (docs/scenarios.md) whose fields can be read and changed by
+// field path (the sweep's paths, docs/studies.md), and run like `mcopt run` with a progress
+// callback, the GIL released while it runs and Ctrl-C ending it with its last iterate.
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <stdexcept>
+
+#include "apps/run_output.hpp"
+#include "core/atomic_file.hpp"
+#include "core/errors.hpp"
+#include "core/yaml_fields.hpp"
+#include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/scenario.hpp"
+#include "outer_nlp/scenario_run.hpp"
+#include "python/bindings.hpp"
+#include "python/robot_handle.hpp"
+#include "study/field_path.hpp"
+
+namespace mcopt::python {
+
+namespace {
+
+struct ScenarioHandle {
+  std::filesystem::path file;
+  YAML::Node root;  ///< the scenario's fields as read and changed; side files relative to `file`
+  Scenario scenario;
+};
+
+/// A YAML scalar as the Python value it reads as: int, float, bool, None or str.
+py::object scalarToPython(const YAML::Node& node) {
+  const std::string& text = node.Scalar();
+  if (node.Tag() != "!") {  // unquoted: may be a number, a boolean or null
+    long long integer = 0;
+    if (YAML::convert<long long>::decode(node, integer)) return py::int_(integer);
+    double number = 0.0;
+    if (YAML::convert<double>::decode(node, number)) return py::float_(number);
+    bool flag = false;
+    if (YAML::convert<bool>::decode(node, flag)) return py::bool_(flag);
+    if (text == "~" || text == "null" || text == "Null" || text == "NULL") return py::none();
+  }
+  return py::str(text);
+}
+
+py::object yamlToPython(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Scalar: return scalarToPython(node);
+    case YAML::NodeType::Sequence: {
+      py::list out;
+      for (const YAML::Node& e : node) out.append(yamlToPython(e));
+      return out;
+    }
+    case YAML::NodeType::Map: {
+      py::dict out;
+      for (const auto& kv : node) out[yamlToPython(kv.first)] = yamlToPython(kv.second);
+      return out;
+    }
+    default: return py::none();
+  }
+}
+
+YAML::Node pythonToYaml(const py::handle& value, const std::string& field) {
+  if (value.is_none()) return YAML::Node(YAML::NodeType::Null);
+  if (py::isinstance<py::bool_>(value)) return YAML::Node(value.cast<bool>());
+  if (py::isinstance<py::int_>(value)) return YAML::Node(value.cast<long long>());
+  if (py::isinstance<py::float_>(value)) return YAML::Node(value.cast<double>());
+  if (py::isinstance<py::str>(value)) return YAML::Node(value.cast<std::string>());
+  if (py::hasattr(value, "tolist") && !py::isinstance<py::str>(value))  // numpy arrays and scalars
+    return pythonToYaml(value.attr("tolist")(), field);
+  if (py::isinstance<py::dict>(value)) {
+    YAML::Node out(YAML::NodeType::Map);
+    for (const auto& [k, v] : value.cast<py::dict>()) {
+      if (!py::isinstance<py::str>(k)) throw py::value_error(field + ": keys must be strings");
+      const std::string key = k.cast<std::string>();
+      out[key] = pythonToYaml(v, field + "." + key);
+    }
+    return out;
+  }
+  if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
+    YAML::Node out(YAML::NodeType::Sequence);
+    std::size_t i = 0;
+    for (const py::handle e : value) out.push_back(pythonToYaml(e, field + "[" + std::to_string(i++) + "]"));
+    return out;
+  }
+  throw py::value_error(field + ": cannot be written to a scenario: " +
+                        std::string(py::str(py::type::of(value).attr("__name__"))));
+}
+
+study::FieldPath pathArgument(const std::string& text) {
+  try {
+    return study::parseFieldPath(text);
+  } catch (const std::invalid_argument& e) {
+    throw py::key_error(text + ": " + e.what());
+  }
+}
+
+/// A refused value, said as a sweep says it (docs/studies.md): the value set from Python has
+/// no line in the file, so the loader's location is replaced by the field and its value.
+std::string refusal(const std::string& message, const std::filesystem::path& file, const std::string& path,
+                    const YAML::Node& value) {
+  std::string reason = message;
+  const std::string head = file.string() + ":";
+  if (reason.compare(0, head.size(), head) == 0) {
+    const std::size_t colon = reason.find(": ", head.size());
+    if (colon != std::string::npos) reason = reason.substr(colon + 2);
+  }
+  YAML::Emitter text;
+  text << YAML::Flow << value;
+  return file.string() + ": " + path + " = " + text.c_str() + ": the scenario refuses it: " + reason;
+}
+
+/// The scenario's tree with side-file paths absolute, so that it can be written anywhere.
+YAML::Node portableTree(const ScenarioHandle& s) {
+  YAML::Node root = YAML::Clone(s.root);
+  for (const char* key : kScenarioSideFileFields) {
+    if (!root[key] || !root[key].IsScalar()) continue;
+    const std::filesystem::path path = root[key].Scalar();
+    if (path.is_relative()) root[key] = std::filesystem::absolute(s.file.parent_path() / path).lexically_normal().string();
+  }
+  return root;
+}
+
+py::dict iterationDict(const IterationRecord& h, const MotionProblem& problem) {
+  py::dict d;
+  d["stage"] = h.stage, d["iteration"] = h.iteration, d["objective"] = h.objective;
+  d["violation"] = h.violation, d["dual_infeasibility"] = h.dualInfeasibility;
+  d["step_size"] = h.stepSize, d["elapsed_seconds"] = h.elapsedSeconds;
+  if (problem.bilevel()) d["infeasible_samples"] = h.inner.infeasible;
+  return d;
+}
+
+py::dict run(const ScenarioHandle& s, const py::object& progress, const std::optional<std::filesystem::path>& out,
+             const std::optional<int>& maxIterations, const std::optional<std::string>& contactForces,
+             const std::optional<bool>& configurationOptimisation) {
+  Scenario scenario = s.scenario;
+  ScenarioOverrides overrides;
+  if (maxIterations) overrides.maxIterations = *maxIterations;
+  if (contactForces) overrides.contactForces = *contactForces;
+  if (configurationOptimisation) overrides.configurationOptimisation = *configurationOptimisation ? "on" : "off";
+  applyOverrides(scenario, overrides);
+  MotionProblem problem(scenario);
+
+  // Python runs only with the GIL: every callback takes it back for its time.
+  std::optional<py::error_already_set> failure;  // raised by the callback: re-raised after the run
+  ScenarioRunEvents events;
+  auto interruption = [&](py::error_already_set& e) {
+    if (e.matches(PyExc_KeyboardInterrupt)) return false;  // Ctrl-C: an interrupted run, not an error
+    failure.emplace(std::move(e));
+    return false;
+  };
+  events.onIteration = [&](const RunRecord& sofar, const MotionProblem& current, const IterationReport&) {
+    if (progress.is_none()) return true;
+    py::gil_scoped_acquire gil;
+    try {
+      const py::object answer = progress(iterationDict(sofar.history.back(), current));
+      return answer.is_none() || answer.cast<bool>();
+    } catch (py::error_already_set& e) {
+      return interruption(e);
+    }
+  };
+  events.keepRunning = [&] {
+    py::gil_scoped_acquire gil;
+    if (PyErr_CheckSignals() == 0) return true;  // runs Python's signal handlers (main thread)
+    py::error_already_set e;
+    return interruption(e);
+  };
+  RunRecord record;
+  {
+    py::gil_scoped_release release;
+    record = runScenario(scenario, problem, events);
+  }
+  if (failure) throw *failure;
+  const cli::RunFiles files = cli::makeRunFiles(problem, record);
+  if (out) cli::writeRunFiles(*out, files);
+  py::dict result = toPython(files.result);
+  result["x"] = vectorToNumpy(record.x);
+  return result;
+}
+
+}  // namespace
+
+void bindScenario(py::module_& m) {
+  py::class_<ScenarioHandle, std::shared_ptr<ScenarioHandle>>(m, "Scenario", R"doc(
+A motion-optimisation scenario (docs/scenarios.md). Fields are read and changed by field path,
+as a sweep names them (docs/studies.md): `s["samples"] = 40`, `s["tasks[kick].target[0]"]`,
+`s["inner.solver"] = "slsqp"`. Every change is validated by the scenario loader at once; a
+refused value raises mcopt.InputError with the loader's message and leaves the scenario as it
+was. `run()` optimises it as `mcopt run` does.)doc")
+      .def(py::init([](const std::filesystem::path& file) {
+             auto s = std::make_shared<ScenarioHandle>();
+             s->file = file;
+             s->root = yaml::loadFile(file);
+             s->scenario = loadScenario(s->root, file);
+             return s;
+           }),
+           py::arg("file"), "Reads and validates a scenario file (errors as `mcopt run` reports them).")
+      .def_property_readonly("file", [](const ScenarioHandle& s) { return s.file; }, "the scenario file (side files are relative to it)")
+      .def_property_readonly("robot", [](const ScenarioHandle& s) {
+        return std::make_shared<RobotHandle>(s.scenario.robot, s.scenario.actuators,
+                                             loadContactSurfaces(s.scenario.contactSurfacesFile, s.scenario.robot));
+      }, "The scenario's robot with its actuators and contact surfaces (a mcopt.Robot).")
+      .def_property_readonly("joint_names", [](const ScenarioHandle& s) { return s.scenario.robot.jointNames(); }, "joints in the order of every joint array of a result")
+      .def_property_readonly("contact_forces", [](const ScenarioHandle& s) { return std::string(toString(s.scenario.contactForces)); }, "the contact-force formulation: 'bilevel', 'splines' or 'variables'")
+      .def(
+          "__getitem__",
+          [](const ScenarioHandle& s, const std::string& path) {
+            try {
+              return yamlToPython(study::getField(s.root, pathArgument(path)));
+            } catch (const std::invalid_argument& e) {
+              throw py::key_error(path + ": " + e.what());
+            }
+          },
+          py::arg("path"), "The value of a field (KeyError when it is not set).")
+      .def(
+          "__setitem__",
+          [](ScenarioHandle& s, const std::string& path, const py::object& value) {
+            YAML::Node changed = YAML::Clone(s.root);
+            const YAML::Node node = pythonToYaml(value, path);
+            try {
+              study::setField(changed, pathArgument(path), node);
+            } catch (const std::invalid_argument& e) {
+              throw py::key_error(path + ": " + e.what());
+            }
+            try {
+              s.scenario = loadScenario(changed, s.file);
+            } catch (const InputError& e) {
+              throw InputError(refusal(e.what(), s.file, path, node));
+            }
+            s.root = changed;
+          },
+          py::arg("path"), py::arg("value"), "Sets a field; the scenario loader validates the result.")
+      .def(
+          "to_dict", [](const ScenarioHandle& s) { return yamlToPython(s.root); },
+          "The scenario's fields as dicts and lists.")
+      .def(
+          "save",
+          [](const ScenarioHandle& s, const std::filesystem::path& path) {
+            YAML::Emitter out;
+            out << portableTree(s);
+            writeFileAtomically(path, std::string(out.c_str()) + "\n");
+          },
+          py::arg("path"),
+          "Writes the scenario (side-file paths made absolute, so it loads from anywhere), atomically.")
+      .def("run", &run, py::arg("progress") = py::none(), py::arg("out") = py::none(),
+           py::arg("max_iterations") = py::none(), py::arg("contact_forces") = py::none(),
+           py::arg("configuration_optimisation") = py::none(),
+           R"doc(Optimises the motion as `mcopt run` does and returns result.json's content as a dict
+(lists of numbers as numpy arrays: 'time' (N,), 'q', 'v', 'a', 'torques', 'power' (N, n), …)
+with 'x', the outer problem's variables. `out`: also write the run's files there.
+`progress(d)` is called after every Ipopt iteration with {'stage', 'iteration', 'objective',
+'violation', 'dual_infeasibility', 'step_size', 'elapsed_seconds'} (and
+'infeasible_samples' for the bilevel formulation); returning False stops the run. The GIL
+is released while it runs; Ctrl-C (KeyboardInterrupt) stops it at the end of the current
+iteration and the result has status 'interrupted' with the last iterate. An exception
+raised by `progress` stops the run and is raised again. The overrides are those of
+`mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation.)doc")
+      .def("__repr__", [](const ScenarioHandle& s) { return "<mcopt.Scenario " + s.file.string() + ">"; });
+}
+
+}  // namespace mcopt::python

@@ -1,0 +1,146 @@
+"""mcopt.Scenario: fields by path, validation with the loader's messages, a run equal to
+`mcopt run` (result.json to 1e-12), progress, stop, Ctrl-C and the GIL released."""
+import json
+import os
+import signal
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import mcopt
+from conftest import SOURCE, assert_same, cli_error, run_cli
+
+KICK = SOURCE / "scenarios" / "hrp2_kick.yaml"
+# Wall-clock times and the scenario's own path differ between two runs of the same problem.
+UNTIMED = ("timings", "seconds", "elapsed_seconds", "scenario", "contact_surfaces")
+
+
+def small_kick(samples=12):
+    s = mcopt.Scenario(KICK)
+    s["samples"] = samples
+    return s
+
+
+def test_fields_by_path():
+    s = mcopt.Scenario(KICK)
+    assert s["samples"] == 100
+    target = s["tasks[kick].target"]
+    assert isinstance(target, list) and len(target) == 3
+    s["tasks[kick].target[0]"] = target[0] + 0.01
+    assert s["tasks[kick].target"][0] == pytest.approx(target[0] + 0.01)
+    s["duration"] = np.float64(1.7)  # numpy scalars are numbers too
+    assert s["duration"] == 1.7
+    assert s.to_dict()["samples"] == 100
+    assert s.joint_names == s.robot.joint_names and len(s.joint_names) == 30
+    with pytest.raises(KeyError, match="no_such_field"):
+        s["no_such_field"]
+    with pytest.raises(KeyError, match="has no element named 'jump'"):
+        s["tasks[jump].target"]
+
+
+def test_a_refused_value_raises_the_loader_message_and_changes_nothing(mcopt_exe, tmp_path):
+    s = mcopt.Scenario(KICK)
+    with pytest.raises(mcopt.InputError) as raised:
+        s["samples"] = "ten"
+    assert str(raised.value) == f"{KICK}: samples = ten: the scenario refuses it: samples: expected a number"
+    assert s["samples"] == 100
+    # The same value in a file: the CLI's words after its file:line.
+    s.save(tmp_path / "ok.yaml")
+    text = (tmp_path / "ok.yaml").read_text().replace("samples: 100", "samples: ten")
+    (tmp_path / "bad.yaml").write_text(text)
+    message = cli_error(mcopt_exe, "run", tmp_path / "bad.yaml", "--out", tmp_path / "o")
+    assert message.split(": ", 1)[1].split(": ", 0)[0].endswith("samples: expected a number")
+    with pytest.raises(mcopt.InputError) as loaded:
+        mcopt.Scenario(tmp_path / "bad.yaml")
+    assert str(loaded.value) == message
+    with pytest.raises(mcopt.InputError, match="unknown key"):
+        s["colour"] = "red"
+    with pytest.raises(ValueError, match="cannot be written"):
+        s["samples"] = object()
+
+
+def test_a_missing_file_raises_the_cli_message(mcopt_exe, tmp_path):
+    with pytest.raises(mcopt.InputError, match="file not found"):
+        mcopt.Scenario(tmp_path / "none.yaml")
+
+
+def test_run_equals_the_cli(mcopt_exe, tmp_path):
+    s = small_kick()
+    s.save(tmp_path / "kick.yaml")
+    code, _, _ = run_cli(mcopt_exe, "run", tmp_path / "kick.yaml", "--max-iterations", 8, "--out", tmp_path / "cli", check=False)
+    assert code == 4  # not optimal after 8 iterations
+    cli = json.loads((tmp_path / "cli" / "result.json").read_text())
+    lines = []
+    result = s.run(progress=lines.append, max_iterations=8, out=tmp_path / "py")
+    assert result["status"] == "maximum_iterations" == cli["status"]
+    assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
+    assert result["q"].shape == (12, 30) and result["time"].shape == (12,)
+    assert result["x"].shape == (result["solver"]["variables"],)
+    assert [l["iteration"] for l in lines] == list(range(9))
+    assert lines[-1]["objective"] == pytest.approx(result["history"][-1]["objective"], rel=1e-15)
+    # The files written from Python are the CLI's files.
+    written = json.loads((tmp_path / "py" / "result.json").read_text())
+    assert_same(written, cli, skip=UNTIMED)
+    for name in ("trajectory.csv", "power_fine.csv", "states.json"):
+        assert (tmp_path / "py" / name).read_text() == (tmp_path / "cli" / name).read_text(), name
+
+
+def test_progress_returning_false_stops_with_the_last_iterate():
+    s = small_kick()
+    result = s.run(progress=lambda line: line["iteration"] < 3, configuration_optimisation=False)
+    assert result["status"] == "interrupted"
+    assert result["solver"]["iterations"] == 3
+    assert np.all(np.isfinite(result["x"]))
+
+
+def test_an_exception_in_progress_is_raised_again():
+    def progress(line):
+        if line["iteration"] == 2:
+            raise RuntimeError("seen enough")
+    with pytest.raises(RuntimeError, match="seen enough"):
+        small_kick().run(progress=progress, configuration_optimisation=False)
+
+
+def test_ctrl_c_interrupts_and_returns_the_last_iterate():
+    """SIGINT while the run is in C++ (no callback): Python's handler raises
+    KeyboardInterrupt at the next check, the run ends 'interrupted' with its iterate."""
+    s = small_kick(40)
+    timer = threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT))
+    started = time.monotonic()
+    timer.start()
+    try:
+        result = s.run(configuration_optimisation=False)
+    finally:
+        timer.cancel()
+    assert result["status"] == "interrupted"
+    assert time.monotonic() - started < 30
+    assert 0 < result["solver"]["iterations"]
+    assert result["reason"].startswith("interrupted")
+    assert np.all(np.isfinite(result["x"])) and result["q"].shape == (40, 30)
+
+
+def test_the_gil_is_released_while_it_runs():
+    ticks = []
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            ticks.append(time.monotonic())
+            time.sleep(0.01)
+
+    worker_result = {}
+    worker = threading.Thread(target=lambda: worker_result.update(small_kick(40).run(max_iterations=15, configuration_optimisation=False)))
+    counter = threading.Thread(target=count)
+    counter.start()
+    started = time.monotonic()
+    worker.start()
+    worker.join()
+    elapsed = time.monotonic() - started
+    stop.set()
+    counter.join()
+    during = [t for t in ticks if started <= t <= started + elapsed]
+    assert worker_result["status"] == "maximum_iterations"
+    # A Python thread kept running: about one tick per 10 ms of the run.
+    assert len(during) >= 0.3 * elapsed / 0.01, (len(during), elapsed)
