@@ -73,6 +73,31 @@ TEST_CASE("study: field paths name keys, list indices and list elements by name"
   }
 }
 
+TEST_CASE("study: a field read by its path is the field set there, and a missing one says which step", "[study]") {
+  const YAML::Node root = YAML::Load("samples: 100\ntasks:\n  - {name: kick, target: [1.0, 0.0, 0.0]}\n  - {name: other, target: [0, 0, 2]}\n");
+  CHECK(getField(root, parseFieldPath("samples")).as<int>() == 100);
+  CHECK(getField(root, parseFieldPath("tasks[kick].target[0]")).as<double>() == 1.0);
+  CHECK(getField(root, parseFieldPath("tasks[1].target[2]")).as<int>() == 2);
+  CHECK(getField(root, parseFieldPath("tasks[other].name")).as<std::string>() == "other");
+  // A copy: changing what was read leaves the tree as it was.
+  YAML::Node read = getField(root, parseFieldPath("tasks[kick].target"));
+  read[0] = 9.0;
+  CHECK(root["tasks"][0]["target"][0].as<double>() == 1.0);
+  const auto refused = [&](const std::string& path) {
+    try {
+      (void)getField(root, parseFieldPath(path));
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK_THAT(refused("inner.solver"), Contains("'inner' is not set"));
+  CHECK_THAT(refused("tasks[throw]"), Contains("'tasks' has no element named 'throw'"));
+  CHECK_THAT(refused("tasks[7]"), Contains("'tasks' has 2 elements: no [7]"));
+  CHECK_THAT(refused("samples.x"), Contains("'samples' is not a mapping"));
+  CHECK_THAT(refused("samples[0]"), Contains("'samples' is not a list"));
+}
+
 TEST_CASE("study: a grid runs through every combination, the first field slowest", "[study]") {
   const test::TempDir dir;
   const Sweep sweep = loadSweep(writeSweep(dir, "vary:\n  - {field: samples, values: [10, 12, 14]}\n"
