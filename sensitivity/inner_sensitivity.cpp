@@ -2,10 +2,12 @@
 
 #include <Eigen/KLUSupport>
 #include <Eigen/LU>
-#include <Eigen/QR>
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 #include <Eigen/UmfPackSupport>
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <sstream>
 #include <vector>
 
@@ -38,12 +40,141 @@ std::string SensitivityDiagnostics::describe() const {
   return s.str();
 }
 
+namespace {
+
+/// x ← A⁻¹ x with PA = LU, in place on the leading rows of x (no allocation).
+void solveInPlace(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu, Eigen::Ref<Eigen::VectorXd> x, Eigen::Ref<Eigen::VectorXd> scratch) {
+  scratch.noalias() = lu.permutationP() * x;
+  lu.matrixLU().triangularView<Eigen::UnitLower>().solveInPlace(scratch);
+  lu.matrixLU().triangularView<Eigen::Upper>().solveInPlace(scratch);
+  x = scratch;
+}
+
+/// x ← A⁻ᵀ x: Aᵀ = Uᵀ Lᵀ P, so solve Uᵀ, then Lᵀ, then apply Pᵀ.
+void solveTransposedInPlace(const Eigen::PartialPivLU<Eigen::MatrixXd>& lu, Eigen::Ref<Eigen::VectorXd> x,
+                            Eigen::Ref<Eigen::VectorXd> scratch) {
+  lu.matrixLU().triangularView<Eigen::Upper>().transpose().solveInPlace(x);
+  lu.matrixLU().triangularView<Eigen::UnitLower>().transpose().solveInPlace(x);
+  scratch.noalias() = lu.permutationP().transpose() * x;
+  x = scratch;
+}
+
+/// 1 / (‖A‖₁ ‖A⁻¹‖₁) with ‖A⁻¹‖₁ estimated by Hager's method (Higham's refinement: at most
+/// five sign iterations, then the alternating-sign test vector), the estimate LAPACK's
+/// dgecon and Eigen's rcond make; written here with workspace vectors so that the
+/// per-sample factorisation allocates nothing (Eigen's own allocates its vectors per call).
+double reciprocalConditionEstimate(const Eigen::MatrixXd& a, const Eigen::PartialPivLU<Eigen::MatrixXd>& lu,
+                                   Eigen::VectorXd& xBuffer, Eigen::VectorXd& signBuffer, Eigen::VectorXd& zBuffer) {
+  const Eigen::Index k = a.rows();
+  if (k == 0) return 1.0;
+  double normA = 0.0;
+  for (Eigen::Index c = 0; c < k; ++c) normA = std::max(normA, a.col(c).lpNorm<1>());
+  if (normA == 0.0) return 0.0;
+  auto x = xBuffer.head(k), sign = signBuffer.head(k), z = zBuffer.head(k);
+  x.setConstant(1.0 / static_cast<double>(k));
+  solveInPlace(lu, x, z);
+  double estimate = x.lpNorm<1>();
+  if (k > 1) {
+    for (Eigen::Index i = 0; i < k; ++i) sign[i] = x[i] >= 0.0 ? 1.0 : -1.0;
+    z = sign;
+    solveTransposedInPlace(lu, z, x);
+    for (int iteration = 0; iteration < 5; ++iteration) {
+      Eigen::Index j = 0;
+      const double zMax = z.cwiseAbs().maxCoeff(&j);
+      x.setZero();
+      x[j] = 1.0;
+      solveInPlace(lu, x, z);
+      const double previous = estimate;
+      estimate = x.lpNorm<1>();
+      bool sameSigns = true;
+      for (Eigen::Index i = 0; i < k; ++i) sameSigns = sameSigns && (x[i] >= 0.0 ? 1.0 : -1.0) == sign[i];
+      if (sameSigns || estimate <= previous) {
+        estimate = std::max(estimate, previous);
+        break;
+      }
+      for (Eigen::Index i = 0; i < k; ++i) sign[i] = x[i] >= 0.0 ? 1.0 : -1.0;
+      z = sign;
+      solveTransposedInPlace(lu, z, x);
+      Eigen::Index jNext = 0;
+      z.cwiseAbs().maxCoeff(&jNext);
+      if (jNext == j || !(zMax > 0.0)) break;
+    }
+    // The alternating test vector catches what the sign iterations miss.
+    for (Eigen::Index i = 0; i < k; ++i)
+      x[i] = (i % 2 == 0 ? 1.0 : -1.0) * (1.0 + static_cast<double>(i) / static_cast<double>(k - 1));
+    solveInPlace(lu, x, z);
+    estimate = std::max(estimate, 2.0 * x.lpNorm<1>() / (3.0 * static_cast<double>(k)));
+  }
+  if (!(estimate > 0.0) || !std::isfinite(estimate)) return 0.0;
+  return 1.0 / (normA * estimate);
+}
+
+/// The eigendecomposition K = V Λ Vᵀ of a symmetric matrix in workspace of its own size:
+/// Eigen's SelfAdjointEigenSolver, step by step (tridiagonalisation, Q formed in place, QR
+/// iterations), with the Householder workspace its compute() allocates on every call kept
+/// here instead.
+struct SymmetricEigen {
+  explicit SymmetricEigen(Eigen::Index k) : vectors(k, k), values(k), subdiagonal(k > 1 ? k - 1 : 1), householder(k > 1 ? k - 1 : 1), workspace(k) {}
+
+  bool compute(const Eigen::MatrixXd& k) {
+    const Eigen::Index n = k.rows();
+    vectors = k.triangularView<Eigen::Lower>();
+    double scale = vectors.cwiseAbs().maxCoeff();  // to [-1, 1], against over- and underflow
+    if (scale == 0.0) scale = 1.0;
+    vectors.triangularView<Eigen::Lower>() /= scale;
+    if (n == 1) {
+      values[0] = vectors(0, 0) * scale;
+      vectors(0, 0) = 1.0;
+      return true;
+    }
+    Eigen::internal::tridiagonalization_inplace(vectors, householder);
+    values = vectors.diagonal();
+    subdiagonal = vectors.diagonal<-1>();
+    Eigen::HouseholderSequence<Eigen::MatrixXd, Eigen::VectorXd, 1>(vectors, householder).setLength(n - 1).setShift(1).evalTo(
+        vectors, workspace);
+    const Eigen::ComputationInfo info = Eigen::internal::computeFromTridiagonal_impl(values, subdiagonal, 30 * n, true, vectors);
+    values *= scale;
+    return info == Eigen::Success;
+  }
+
+  Eigen::MatrixXd vectors;
+  Eigen::VectorXd values, subdiagonal, householder, workspace;
+};
+
+/// x = K⁺ b = V Λ⁺ Vᵀ b for symmetric K = V Λ Vᵀ, eigenvalues below ε k max|λ| taken as
+/// zero (the rank threshold of Eigen's complete orthogonal decomposition). `projected` is
+/// workspace with at least K's rows and b's columns.
+void leastNormSolve(const SymmetricEigen& eigen, const Eigen::Ref<const Eigen::MatrixXd>& b, Eigen::MatrixXd& projected,
+                    Eigen::Ref<Eigen::MatrixXd> x) {
+  const Eigen::Index k = b.rows();
+  if (projected.rows() < k || projected.cols() != b.cols()) projected.resize(k, b.cols());
+  auto vtb = projected.topRows(k);
+  vtb.noalias() = eigen.vectors.transpose() * b;
+  const double threshold = Eigen::NumTraits<double>::epsilon() * static_cast<double>(k) * eigen.values.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < k; ++i) {
+    if (std::abs(eigen.values[i]) > threshold)
+      vtb.row(i) /= eigen.values[i];
+    else
+      vtb.row(i).setZero();
+  }
+  x.noalias() = eigen.vectors * vtb;
+}
+
+}  // namespace
+
 struct InnerSensitivity::Impl {
   SensitivitySettings settings;
   SensitivityDiagnostics diagnostics;
   int variables = 0;
   Eigen::MatrixXd kkt;
-  Eigen::CompleteOrthogonalDecomposition<Eigen::MatrixXd> rankRevealing;
+  // Near-singular systems (formulation.md §8: dependent active rows, or a null space no row
+  // or curvature fixes) are solved in the least-norm sense through the symmetric KKT
+  // matrix's eigendecomposition, K⁺ = V Λ⁺ Vᵀ — the minimum-norm solution a complete
+  // orthogonal decomposition gives, but computed in workspace made the first time a system
+  // of that size is near-singular (the COD's solve allocated its temporaries every call).
+  std::vector<std::unique_ptr<SymmetricEigen>> eigenBySize;
+  Eigen::MatrixXd projected;  ///< Vᵀ b, then Λ⁺ Vᵀ b (capacity × columns)
+  Eigen::MatrixXd sparseRhs, sparseSolution;  ///< contiguous, of the used size: what SuiteSparse reads and writes
   bool useRankRevealing = false;
   Eigen::SparseMatrix<double> sparse;
   Eigen::KLU<Eigen::SparseMatrix<double>> klu;
@@ -57,6 +188,9 @@ struct InnerSensitivity::Impl {
   // size would, and allocates nothing afterwards.
   int smallest = 0, capacity = -1;
   std::vector<Eigen::MatrixXd> systemBySize;
+  // Workspace of the condition estimate and of the solves, sized to the largest system (and
+  // the right-hand sides' column count) and used by their leading rows.
+  Eigen::VectorXd estimateX, estimateSign, estimateZ;
   std::vector<Eigen::PartialPivLU<Eigen::MatrixXd>> luBySize;
   int used = 0;  ///< size of the system in use
   const Eigen::MatrixXd& system() const { return systemBySize[static_cast<std::size_t>(used - smallest)]; }
@@ -173,6 +307,9 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       m.systemBySize.emplace_back(k, k);
       m.luBySize.emplace_back(k);
     }
+    m.estimateX.resize(size), m.estimateSign.resize(size), m.estimateZ.resize(size);
+    m.eigenBySize.clear();
+    m.eigenBySize.resize(static_cast<std::size_t>(size - m.smallest + 1));
   }
   m.used = next;
   m.diagnostics.size = next;
@@ -183,10 +320,14 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   // rows, whose multipliers are then not unique while dF is) is solved in the least-norm sense.
   Eigen::PartialPivLU<Eigen::MatrixXd>& lu = m.luBySize[static_cast<std::size_t>(next - m.smallest)];
   lu.compute(system);
-  m.diagnostics.reciprocalCondition = lu.rcond();
+  m.diagnostics.reciprocalCondition = reciprocalConditionEstimate(system, lu, m.estimateX, m.estimateSign, m.estimateZ);
   if (!std::isfinite(m.diagnostics.reciprocalCondition)) m.diagnostics.reciprocalCondition = 0.0;
   m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
-  if (m.useRankRevealing) m.rankRevealing.compute(system);
+  if (m.useRankRevealing) {
+    auto& eigen = m.eigenBySize[static_cast<std::size_t>(next - m.smallest)];
+    if (!eigen) eigen = std::make_unique<SymmetricEigen>(next);
+    if (!eigen->compute(system)) m.diagnostics.reciprocalCondition = 0.0;
+  }
   m.backendInUse = KktBackend::Dense;
   if (m.settings.backend != KktBackend::Dense && !m.useRankRevealing) {
     m.sparse = system.sparseView();
@@ -222,18 +363,32 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
     throw InputError("sensitivity: right-hand sides must be 6nc × m and 6 × m");
   // Buffers reused from call to call (allocation-free for the same shapes: the per-sample
   // path of MultiContactGradientEvaluator).
-  Eigen::MatrixXd& rhs = impl_->rhs;
-  Eigen::MatrixXd& solution = impl_->solution;
-  rhs.setZero(size, dStationarity.cols());
+  // The system's size follows the active set from sample to sample: the buffers have the
+  // largest size's rows and are used by their leading `size` rows.
+  const Eigen::Index columns = dStationarity.cols();
+  if (m.rhs.rows() != m.capacity || m.rhs.cols() != columns) m.rhs.resize(m.capacity, columns);
+  if (m.solution.rows() != m.capacity || m.solution.cols() != columns) m.solution.resize(m.capacity, columns);
+  auto rhs = m.rhs.topRows(size);
+  auto solution = m.solution.topRows(size);
+  rhs.setZero();
   rhs.topRows(n) = -dStationarity;
   rhs.middleRows(n, 6) = -dBalance;
-  solution.resize(size, dStationarity.cols());
   switch (m.backendInUse) {
-    case KktBackend::SparseKlu: solution = m.klu.solve(rhs); break;
-    case KktBackend::SparseUmfpack: solution = m.umfpack.solve(rhs); break;
+    // SuiteSparse takes contiguous matrices (leading dimension = rows), and allocates
+    // its own workspace on every factorisation anyway: plain matrices of the used size.
+    case KktBackend::SparseKlu:
+      m.sparseRhs = rhs;
+      m.sparseSolution = m.klu.solve(m.sparseRhs);
+      solution = m.sparseSolution;
+      break;
+    case KktBackend::SparseUmfpack:
+      m.sparseRhs = rhs;
+      m.sparseSolution = m.umfpack.solve(m.sparseRhs);
+      solution = m.sparseSolution;
+      break;
     case KktBackend::Dense:
       if (m.useRankRevealing)
-        solution = m.rankRevealing.solve(rhs);
+        leastNormSolve(*m.eigenBySize[static_cast<std::size_t>(size - m.smallest)], rhs, m.projected, solution);
       else
         solution.noalias() = m.factor().solve(rhs);
       break;
