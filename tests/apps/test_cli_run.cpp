@@ -209,6 +209,47 @@ TEST_CASE("run: a run killed outright leaves its latest checkpoint, the iterate 
   CHECK(largest > 1.0);
   CHECK(worst <= 1e-9 * largest);
   CHECK(killed["energy"].get<double>() == Approx(ended["energy"].get<double>()).epsilon(1e-9));
+
+  // Byte for byte: the motion's files are the stopped run's files, and so is result.json but
+  // for what says how the run went (status, its words, wall-clock times, Ipopt's counts).
+  const auto bytes = [](const std::filesystem::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (const char* file : {"trajectory.csv", "power_fine.csv", "states.json", "contact_wrenches.json"}) {
+    INFO(file);
+    CHECK(bytes(out / file) == bytes(limited / file));
+  }
+  Json killedMotion = killed, endedMotion = ended;
+  for (Json* j : {&killedMotion, &endedMotion}) {
+    for (const char* key : {"status", "message", "reason", "timings", "solver", "history", "continuation", "configuration_optimisation"})
+      j->erase(key);
+  }
+  CHECK(killedMotion.dump(1) == endedMotion.dump(1));
+  // What was left out differs only where it should.
+  CHECK(killed["history"].size() == ended["history"].size());
+  CHECK(killed["solver"]["objective_evaluations"] == ended["solver"]["objective_evaluations"]);
+}
+
+TEST_CASE("run: the main job ends optimal and exits 0", "[cli][run]") {
+  // The bundled kick as scripts/run.sh runs it (configuration optimisation, the bundled
+  // Hessian, screening and smoothing), on fewer samples so that it converges in seconds.
+  const test::TempDir dir;
+  const int samples = kUnderSanitizers ? 8 : 16;
+  const auto scenario = kickVariant(dir, [&](YAML::Node& root) { root["samples"] = samples; });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out));
+  INFO(r.all());
+  REQUIRE(r.exitCode == 0);
+  CHECK_THAT(r.output, Contains("EXIT: Optimal Solution Found") && Contains("status             optimal"));
+  const Json result = readJson(out / "result.json");
+  CHECK(result["status"] == "optimal");
+  CHECK(result["solver"]["status"] == "optimal");
+  CHECK(result["max_violation"].get<double>() <= 1e-6);
+  CHECK(result["energy"].get<double>() > 0.0);
+  CHECK(result["q"].size() == static_cast<std::size_t>(samples));
+  CHECK(result["configuration_optimisation"]["start"]["optimised"] == true);
+  CHECK(!result.contains("reason"));
 }
 
 TEST_CASE("run: a continuation solves its stages in turn, each from the last one's iterate", "[cli][run]") {

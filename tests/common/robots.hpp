@@ -1,14 +1,21 @@
 #pragma once
 // Loading the test robots: ours (always) and the third-party ones of ../shared.
+#include <catch2/catch.hpp>
+
 #include "common/test_support.hpp"
 
 namespace mcopt::test {
 
 /// Every robot the physics tests run on. Romeo's URDF has non-physical inertias
 /// (RShoulderYawLink breaks the triangle inequality by 80 %), so test loads allow them.
+/// Says at run time which robots a test covers: without ../shared it is HRP-2 alone.
 inline std::vector<NamedRobot> allRobots() {
   std::vector<NamedRobot> robots = sharedRobots();
   robots.insert(robots.begin(), hrp2());
+  std::string names;
+  for (const NamedRobot& r : robots) names += (names.empty() ? "" : ", ") + r.name;
+  WARN("on " << robots.size() << " robots: " << names
+             << (robots.size() == 1 ? " (no ../shared: the third-party robots are not covered)" : ""));
   return robots;
 }
 

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <limits>
+#include <string>
 
 #include "common/random_inner_problem.hpp"
 #include "common/test_support.hpp"
@@ -34,6 +35,26 @@ double minNormalForce(const ContactProblem& p, const Eigen::VectorXd& F) {
   return least;
 }
 
+/// The least balance slack of two contacts at the world origin (identity frames) asked for a
+/// pull, a slip or a tip (infeasible test below), by hand:
+///   pull (0, 0, −f): contacts only push, so nothing helps: the slack is the demand;
+///   slip (h, 0, f): the contacts' sum can give any (fx, fz) with |fx| ≤ μ_max fz (put the load
+///     on the grippier one), so the slack is (h, f) minus its projection on the line fx = μ_max fz;
+///   tip (0, 0, f, 0, m, 0): my ≤ a fz with a = max(−x_min) (−my = x_cop fz, formulation.md
+///     §7), so the slack is (f, m) minus its projection on the line my = a fz.
+Vector6 exactLeastSlack(const std::string& what, const Vector6& demand, const std::vector<ContactSpec>& contacts) {
+  Vector6 slack = demand;
+  if (what == "pull") return slack;
+  double slope = 0.0;
+  for (const ContactSpec& c : contacts) slope = std::max(slope, what == "slip" ? c.friction : -c.xMin);
+  // Projection of (u, z) = (horizontal or moment, normal force) on the ray u = slope z.
+  const int u = what == "slip" ? 0 : 4;
+  const double z = demand[2], along = (demand[u] * slope + z) / (1.0 + slope * slope);
+  slack[u] = demand[u] - slope * along;
+  slack[2] = z - along;
+  return slack;
+}
+
 double relativeGap(double value, double reference) { return std::abs(value - reference) / (1.0 + std::abs(reference)); }
 
 struct SolverTally {
@@ -57,10 +78,15 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
   // Under the sanitizers (ASan's allocator behind every Ipopt and MUMPS allocation: 25 s
   // become more than 10 minutes) a fifth of the catalogue runs; the acceptance count is the
   // Release build's.
+  struct Measured {
+    int unloaded, slsqpOptimal, slsqpSame, ipoptOptimal, ipoptSame;
+  };
 #ifdef MCOPT_UNDER_SANITIZERS
   constexpr int kPerContactCount = 67;
+  constexpr Measured kMeasured{3, 200, 201, 201, 201};  // of 201
 #else
   constexpr int kPerContactCount = 334;
+  constexpr Measured kMeasured{43, 973, 1001, 998, 1001};  // of 1002
 #endif
   for (int nc : {2, 3, 4}) {
     for (int trial = 0; trial < kPerContactCount; ++trial, ++problems) {
@@ -96,13 +122,17 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
              << "optimal " << problems << ", worst KKT residual " << worstKkt << "; SLSQP optimal "
              << slsqpTally.optimal << ", at the same optimum " << slsqpTally.sameOptimum << "; Ipopt optimal "
              << ipoptTally.optimal << ", at the same optimum " << ipoptTally.sameOptimum);
-  // The degenerate case the method is built for is exercised, not avoided.
-  CHECK(unloaded >= problems / 100);  // 43 of 1002 measured
-  // The third-party solvers fail to certify a few per cent (unloaded contacts, where the
-  // smooth cone's curvature is 1/δ, and Ipopt's iteration limit); they must still reach the
-  // same optimum on the great majority (measured: SLSQP 1001, Ipopt 1001 of 1002).
-  CHECK(slsqpTally.sameOptimum >= 0.97 * problems);
-  CHECK(ipoptTally.sameOptimum >= 0.95 * problems);
+  // The figures docs/inner-problem.md states, as thresholds. The catalogue is seeded and the
+  // active-set method and Ipopt are deterministic, so their counts are required exactly as
+  // measured. SLSQP's are given a margin of 1 % of the catalogue: NLopt 2.7.1's SLSQP reads
+  // memory it allocated without initialising it (valgrind, docs/python.md), so on the hard
+  // problems its path can change from run to run (measured: the same counts on 3 Release runs).
+  CHECK(unloaded >= kMeasured.unloaded);  // the degenerate case the method is built for
+  CHECK(ipoptTally.optimal >= kMeasured.ipoptOptimal);
+  CHECK(ipoptTally.sameOptimum >= kMeasured.ipoptSame);
+  const int slsqpMargin = problems / 100;
+  CHECK(slsqpTally.optimal >= kMeasured.slsqpOptimal - slsqpMargin);
+  CHECK(slsqpTally.sameOptimum >= kMeasured.slsqpSame - slsqpMargin);
 }
 
 TEST_CASE("with a positive definite objective the solvers agree on wrenches and multipliers too",
@@ -127,7 +157,8 @@ TEST_CASE("with a positive definite objective the solvers agree on wrenches and 
     const double multiplierScale = 1.0 + a.balanceMultipliers.cwiseAbs().maxCoeff();
     CHECK((a.balanceMultipliers - b.balanceMultipliers).cwiseAbs().maxCoeff() <= 1e-4 * multiplierScale);
   }
-  CHECK(compared >= 36);
+  WARN("Ipopt compared with the active-set method on " << compared << " of 40");
+  CHECK(compared == 40);  // measured: every one (seeded, deterministic)
 }
 
 TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inner][solvers]") {
@@ -139,6 +170,7 @@ TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inn
   auto ipopt = makeIpoptSolver();
   const std::vector<int> facetCounts = {16, 64, 256, 1024};
   std::vector<double> worstGap(facetCounts.size(), 0.0);
+  int pyramidsSolved = 0, pyramidsInfeasible = 0, ipoptCompared = 0;
   for (int trial = 0; trial < 20; ++trial) {
     const RandomProblem r = randomProblem(rng, 2 + trial % 3);
     InnerResult cone;
@@ -149,8 +181,12 @@ TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inn
       InnerResult result;
       activeSet->solve(pyramid, result);
       INFO("trial " << trial << ", " << facetCounts[f] << " facets: " << toString(result.status) << " " << result.message);
-      if (result.status == InnerStatus::Infeasible) continue;  // an inscribed pyramid may lose feasibility
+      if (result.status == InnerStatus::Infeasible) {  // an inscribed pyramid may lose feasibility
+        ++pyramidsInfeasible;
+        continue;
+      }
       REQUIRE(result.status == InnerStatus::Optimal);
+      ++pyramidsSolved;
       CHECK(result.kktResidual <= 1e-9);
       const double gap = (result.objective - cone.objective) / (1.0 + std::abs(cone.objective));
       CHECK(gap >= -1e-9);
@@ -158,10 +194,17 @@ TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inn
       if (f == 0) {  // a pure QP: the third-party solvers agree with it
         InnerResult check;
         ipopt->solve(pyramid, check);
-        if (check.status == InnerStatus::Optimal) CHECK(relativeGap(check.objective, result.objective) <= 1e-6);
+        if (check.status != InnerStatus::Optimal) continue;
+        CHECK(relativeGap(check.objective, result.objective) <= 1e-6);
+        ++ipoptCompared;
       }
     }
   }
+  // Every skip counted (seeded and deterministic: as measured).
+  WARN(pyramidsSolved << " pyramids solved, " << pyramidsInfeasible << " infeasible; Ipopt compared on " << ipoptCompared);
+  CHECK(pyramidsSolved + pyramidsInfeasible == 80);
+  CHECK(pyramidsSolved == 80);  // measured: none infeasible
+  CHECK(ipoptCompared == 20);
   for (std::size_t f = 1; f < facetCounts.size(); ++f) CHECK(worstGap[f] < worstGap[f - 1]);
   CHECK(worstGap.back() <= 1e-5);
 }
@@ -195,8 +238,9 @@ TEST_CASE("the wrench cone's optimum is admissible for the report model, yaw bou
   }
   WARN(solved << " wrench-cone problems solved; in " << yawBinding
               << " the report optimum would spin a contact (yaw rows violated), the wrench-cone optimum does not");
-  CHECK(solved >= 40);
-  CHECK(yawBinding >= 5);
+  // Seeded and deterministic (the active-set method): every one of the 60, as measured.
+  CHECK(solved == 60);
+  CHECK(yawBinding == 60);
 }
 
 TEST_CASE("infeasible problems: the active-set method proves it and finds the least slack", "[inner][solvers]") {
@@ -215,8 +259,10 @@ TEST_CASE("infeasible problems: the active-set method proves it and finds the le
   int thirdPartyInfeasible = 0, thirdPartyRuns = 0;
 #ifdef MCOPT_UNDER_SANITIZERS
   constexpr int kTrials = 1;  // the third-party solvers' elastic phases are slow under ASan
+  constexpr int kThirdPartyInfeasible = 1;
 #else
   constexpr int kTrials = 3;
+  constexpr int kThirdPartyInfeasible = 5;
 #endif
   for (const auto& [what, demand] : demands) {
     for (int trial = 0; trial < kTrials; ++trial) {
@@ -229,7 +275,10 @@ TEST_CASE("infeasible problems: the active-set method proves it and finds the le
       INFO(what << ", trial " << trial << ", active-set: " << least.message << "; slack " << least.balanceSlack.transpose());
       REQUIRE(least.status == InnerStatus::Infeasible);
       CHECK(least.kktResidual <= 1e-9);
-      CHECK(least.balanceSlack.norm() > 1.0);
+      // The exact least slack: W minus its projection onto what the contacts can give.
+      const Vector6 expected = exactLeastSlack(what, demand, r.contacts);
+      INFO("expected slack " << expected.transpose());
+      CHECK((least.balanceSlack - expected).cwiseAbs().maxCoeff() <= 1e-6 * demand.norm());
       // Feasible for the shifted balance: the slack is what the contacts cannot give.
       CHECK(worstViolation(p, least.wrenches) <= 1e-8 + least.balanceSlack.cwiseAbs().maxCoeff());
       ContactProblem shifted = p;
@@ -254,6 +303,10 @@ TEST_CASE("infeasible problems: the active-set method proves it and finds the le
   }
   WARN("SLSQP and Ipopt certified " << thirdPartyInfeasible << " of " << thirdPartyRuns
                                     << " infeasible samples as infeasible; the rest they report failed");
+  CHECK(thirdPartyRuns == 2 * kTrials * static_cast<int>(demands.size()));
+  // Measured 5 of 18 (Release; 1 of 6 under the sanitizers):
+  // fewer would mean an adapter lost its elastic phase.
+  CHECK(thirdPartyInfeasible >= kThirdPartyInfeasible);
 }
 
 TEST_CASE("warm starts along a smooth motion cut the active-set iterations, not the accuracy", "[inner][solvers]") {
@@ -285,5 +338,7 @@ TEST_CASE("warm starts along a smooth motion cut the active-set iterations, not 
   }
   WARN("mean active-set iterations per sample: warm " << double(warmIterations) / kSamples << ", cold "
                                                       << double(coldIterations) / kSamples);
-  CHECK(warmIterations < coldIterations);
+  // docs/inner-problem.md: warm 3.84, cold 10.73 a sample (seeded, deterministic).
+  CHECK(double(warmIterations) / kSamples <= 3.84 + 1e-9);
+  CHECK(double(coldIterations) / kSamples >= 10.73 - 1e-9);
 }

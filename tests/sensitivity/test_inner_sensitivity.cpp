@@ -68,7 +68,7 @@ TEST_CASE("dF/dτ0 and dF/dW agree with central differences of the re-solved pro
     Eigen::MatrixXd dTau0, dBalance;
     sensitivity.dataSensitivities(p, dTau0, dBalance);
     const double forceScale = 1.0 + solution.wrenches.cwiseAbs().maxCoeff();
-    for (int which = 0; which < r.tau0.size() + 6; which += 3) {
+    for (int which = 0; which < r.tau0.size() + 6; ++which) {  // every τ0 and every W component
       const double step = 1e-4 * (which < r.tau0.size() ? 30.0 : 300.0);
       const Eigen::VectorXd difference =
           (solveMoved(*activeSet, r, which, step) - solveMoved(*activeSet, r, which, -step)) / (2.0 * step);
@@ -81,8 +81,10 @@ TEST_CASE("dF/dτ0 and dF/dW agree with central differences of the re-solved pro
   }
   WARN(checked << " problems checked (" << withCone << " with an active cone, " << unloaded
                << " with an unloaded contact), " << degenerate << " degenerate ones reported and skipped");
-  CHECK(checked >= 16);
-  CHECK(withCone >= 3);
+  // Seeded and deterministic: the counts measured, so that a skip cannot grow unseen.
+  CHECK(checked + degenerate == 24);
+  CHECK(checked >= 24);  // measured: 24, none degenerate
+  CHECK(withCone >= 16);
 }
 
 TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[sensitivity]") {
@@ -91,6 +93,7 @@ TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[s
   // and ∂L/∂W = −λ.
   std::mt19937 rng(307);
   auto activeSet = makeActiveSetSolver();
+  int checked = 0;
   for (int trial = 0; trial < 12; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
     const ContactProblem p = test::assemble(r, ContactModel::Report);
@@ -98,7 +101,8 @@ TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[s
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
     InnerSensitivity sensitivity;
-    if (sensitivity.factorize(p, solution).degenerate()) continue;
+    if (sensitivity.factorize(p, solution).degenerate()) continue;  // one-sided: counted below
+    ++checked;
     Eigen::MatrixXd dTau0, dBalance;
     sensitivity.dataSensitivities(p, dTau0, dBalance);
     const Eigen::VectorXd gradient = p.hessian * solution.wrenches + p.gradient;  // ∇_F of what is minimised
@@ -119,6 +123,8 @@ TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[s
       CHECK(difference == Approx(expected).epsilon(1e-6).margin(1e-6));
     }
   }
+  WARN("envelope theorem checked on " << checked << " of 12 problems (the others degenerate)");
+  CHECK(checked >= 12);  // measured: 12 of 12
 }
 
 TEST_CASE("dense, KLU and UMFPACK factorisations give the same sensitivities", "[sensitivity]") {
@@ -190,7 +196,7 @@ TEST_CASE("an unloaded contact is held at zero and the derivatives still match d
     Eigen::MatrixXd dTau0, dBalance;
     sensitivity.dataSensitivities(p, dTau0, dBalance);
     CHECK(dTau0.bottomRows(6).topRows(5).cwiseAbs().maxCoeff() <= 1e-12);  // the hand's wrench stays zero
-    for (int which = 0; which < r.tau0.size() + 6; which += 5) {
+    for (int which = 0; which < r.tau0.size() + 6; ++which) {
       const double step = 1e-4 * (which < r.tau0.size() ? 30.0 : 300.0);
       const Eigen::VectorXd difference =
           (solveMoved(*activeSet, r, which, step) - solveMoved(*activeSet, r, which, -step)) / (2.0 * step);
@@ -242,8 +248,9 @@ TEST_CASE("sensitivities from each solver's own result agree with the active-set
   WARN("worst relative difference to the active-set sensitivities: SLSQP " << worst[0] << " (" << compared[0]
                                                                             << " problems), Ipopt " << worst[1] << " ("
                                                                             << compared[1] << ")");
-  CHECK(compared[0] >= 8);
-  CHECK(compared[1] >= 8);
+  // Measured 14 and 15 of 15; SLSQP one less for its run-to-run variation (docs/python.md).
+  CHECK(compared[0] >= 13);
+  CHECK(compared[1] >= 15);
 }
 
 TEST_CASE("a weakly active constraint is reported as degenerate and left out", "[sensitivity]") {
