@@ -3,8 +3,9 @@
 // whole motion with Ipopt (formulation.md §10), printing a line per iteration, and writes
 // the results atomically. Ctrl-C (SIGINT) or SIGTERM stops Ipopt at the end of the current
 // iteration; the last iterate is then written with status "interrupted". While Ipopt runs,
-// the current iterate is written every --checkpoint-seconds with status "running", so that
-// a run killed outright (SIGKILL, power loss) still leaves its latest complete result.
+// the current iterate is written every --checkpoint-seconds with status "running" (result.json
+// alone), so that a run killed outright (SIGKILL, power loss) still leaves its latest
+// complete result.
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -55,7 +56,7 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
   checkpoint.optimisationSeconds = optimisationSeconds;
   checkpoint.totalSeconds = totalSeconds;
   try {
-    writeRunOutput(out, problem, checkpoint);
+    writeCheckpointFile(out, makeRunFiles(problem, checkpoint));
   } catch (const std::exception& e) {
     std::cerr << "mcopt: warning: checkpoint after iteration " << r.iteration << " not written: " << e.what() << "\n";
   }

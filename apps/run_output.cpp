@@ -267,6 +267,13 @@ void writeRunFiles(const std::filesystem::path& directory, const RunFiles& files
   writeFileAtomically(directory / "result.json", files.result.dump(1) + "\n");
 }
 
+void writeCheckpointFile(const std::filesystem::path& directory, const RunFiles& files) {
+  std::filesystem::create_directories(directory);
+  for (const char* side : {"trajectory.csv", "power_fine.csv", "states.json", "contact_wrenches.json"})
+    std::filesystem::remove(directory / side);
+  writeFileAtomically(directory / "result.json", files.result.dump(1) + "\n");
+}
+
 std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
                                          const RunRecord& record) {
   const RunFiles files = makeRunFiles(problem, record);

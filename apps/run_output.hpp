@@ -28,6 +28,13 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record);
 /// Writes the files into `directory` (created if needed), result.json last.
 void writeRunFiles(const std::filesystem::path& directory, const RunFiles& files);
 
+/// A checkpoint of a run still going (status `running`): result.json alone, after removing
+/// the side files an earlier run may have left, so that what a killed run leaves is one
+/// iterate — never side files of one iteration beside a result.json of another (each file
+/// is atomic, a set of files is not). result.json holds the whole motion; the side files
+/// come with the run's final result.
+void writeCheckpointFile(const std::filesystem::path& directory, const RunFiles& files);
+
 /// makeRunFiles then writeRunFiles. Returns the exact energy and the largest violation.
 std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
                                          const RunRecord& record);
