@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -19,6 +20,12 @@ void bindRobot(py::module_& m);
 void bindDynamics(py::module_& m);
 void bindInner(py::module_& m);
 void bindScenario(py::module_& m);
+
+/// Held by whatever runs Ipopt from Python (Scenario.run, InnerSolver("ipopt").solve), taken
+/// with the GIL released: Ipopt 3.11's MUMPS is not thread-safe, and with the GIL released two
+/// Python threads could otherwise run it at once (inner_qp/ipopt_solver.cpp serialises the
+/// inner solves among themselves only).
+std::mutex& ipoptMutex();
 
 /// A JSON value as Python: objects → dict, lists of numbers → 1-D numpy arrays, lists of
 /// equally long lists of numbers → 2-D arrays, other lists → lists, null → None.

@@ -247,7 +247,13 @@ An inner solver: 'active-set' (ours), 'slsqp' (NLopt) or 'ipopt'.)doc")
             // does along its list), when it has this problem's size.
             if (previous && previous->result.wrenches.size() == 6 * problem->problem.contactCount)
               out->result = previous->result;
-            s.solver->solve(problem->problem, out->result);
+            if (s.name == "ipopt") {  // MUMPS: one Ipopt at a time in the process (bindings.hpp)
+              py::gil_scoped_release release;
+              const std::lock_guard<std::mutex> oneIpoptAtATime(ipoptMutex());
+              s.solver->solve(problem->problem, out->result);
+            } else {
+              s.solver->solve(problem->problem, out->result);
+            }
             return out;
           },
           py::arg("problem"), py::arg("previous") = nullptr,

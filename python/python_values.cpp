@@ -65,6 +65,11 @@ std::string shapeText(const py::array& a) {
 
 }  // namespace
 
+std::mutex& ipoptMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
 py::object toPython(const nlohmann::json& value) { return convert(value); }
 py::object toPython(const nlohmann::ordered_json& value) { return convert(value); }
 

@@ -169,6 +169,7 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
   RunRecord record;
   {
     py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> oneIpoptAtATime(ipoptMutex());
     record = runScenario(scenario, problem, events);
   }
   if (failure) throw *failure;
@@ -252,7 +253,8 @@ with 'x', the outer problem's variables. `out`: also write the run's files there
 `progress(d)` is called after every Ipopt iteration with {'stage', 'iteration', 'objective',
 'violation', 'dual_infeasibility', 'step_size', 'elapsed_seconds'} (and
 'infeasible_samples' for the bilevel formulation); returning False stops the run. The GIL
-is released while it runs; Ctrl-C (KeyboardInterrupt) stops it at the end of the current
+is released while it runs (runs from several threads take turns: one Ipopt at a time, its
+linear solver MUMPS not being thread-safe); Ctrl-C (KeyboardInterrupt) stops it at the end of the current
 iteration and the result has status 'interrupted' with the last iterate. An exception
 raised by `progress` stops the run and is raised again. The overrides are those of
 `mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation.)doc")

@@ -121,6 +121,32 @@ def test_ctrl_c_interrupts_and_returns_the_last_iterate():
     assert np.all(np.isfinite(result["x"])) and result["q"].shape == (40, 30)
 
 
+def test_runs_from_two_threads_take_turns_and_equal_runs_one_after_the_other():
+    """Ipopt's MUMPS is not thread-safe: runs (and Ipopt inner solves) from several threads
+    are serialised by the module, so results are those of the same runs in sequence."""
+    alone = [small_kick(12).run(max_iterations=6, configuration_optimisation=False)["x"] for _ in range(2)]
+    results = [None, None]
+    problem_data = {}
+
+    def run(k):
+        results[k] = small_kick(12).run(max_iterations=6, configuration_optimisation=False)["x"]
+
+    def inner_solves():
+        robot = small_kick().robot
+        d = mcopt.Dynamics(robot, "r_sole")
+        p = mcopt.InnerProblem.from_state(d, np.zeros(30), contacts=["r_sole", "l_sole"])
+        problem_data["objectives"] = [mcopt.InnerSolver("ipopt").solve(p).objective for _ in range(20)]
+
+    threads = [threading.Thread(target=run, args=(k,)) for k in range(2)] + [threading.Thread(target=inner_solves)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for k in range(2):
+        np.testing.assert_array_equal(results[k], alone[k])
+    assert len(set(problem_data["objectives"])) == 1
+
+
 def test_the_gil_is_released_while_it_runs():
     ticks = []
     stop = threading.Event()
