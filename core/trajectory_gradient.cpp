@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include "core/no_malloc_scope.hpp"
+
 #include "core/errors.hpp"
 
 namespace mcopt {
@@ -33,6 +35,10 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
   }
   const double dt = duration / (count - 1);
 
+  // Each sample's Jacobian block is sized by its first evaluation: checked once they all are.
+  bool sized = true;
+  for (const SampleTorqueJacobian& block : g.torque) sized = sized && block.dtauDx.size() > 0;
+  const NoMallocScope perSample(sized);
 #pragma omp parallel for schedule(static)
   for (int s = 0; s < count; ++s) {
     ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];

@@ -2,6 +2,8 @@
 
 #include <omp.h>
 
+#include "core/no_malloc_scope.hpp"
+
 #include "core/errors.hpp"
 #include "core/inverse_dynamics.hpp"
 
@@ -155,6 +157,9 @@ void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& pa
   }
   samples_.parametrization().controlPoints(parameters, controlPoints_);
   const int threads = static_cast<int>(workspaces_.size());
+  // The inner solvers size their buffers on their first problem: checked from the second
+  // evaluation on (the contact set is fixed, so the shapes are).
+  const NoMallocScope perSample(sized_ && capture_ == nullptr);  // copying problems out allocates
 #pragma omp parallel num_threads(threads)
   {
     // One contiguous block of samples per thread: the warm start follows the motion.
@@ -183,6 +188,7 @@ void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& pa
     r.failedSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Failed;
   }
   r.motion.energy = positiveEnergy(r.motion.power, r.motion.time);
+  sized_ = true;
 }
 
 }  // namespace mcopt

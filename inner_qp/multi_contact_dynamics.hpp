@@ -88,6 +88,7 @@ class MultiContactEvaluator {
   Eigen::MatrixXd controlPoints_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;  ///< one per thread
   std::vector<InnerResult> previous_;                   ///< per sample: the warm start of the next evaluation
+  bool sized_ = false;  ///< an evaluation has run: the inner solvers' buffers are sized (NoMallocScope)
   std::vector<ContactProblem>* capture_ = nullptr;
 };
 
