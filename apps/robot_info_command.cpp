@@ -6,8 +6,6 @@
 #include "apps/json_io.hpp"
 #include "apps/robot_info_json.hpp"
 #include "core/actuators.hpp"
-#include "core/inverse_dynamics.hpp"
-#include "core/kinematics.hpp"
 
 namespace mcopt::cli {
 
@@ -22,30 +20,25 @@ int runRobotInfo(const RobotInfoOptions& o) {
   const RobotModel robot = loadUrdfFile(o.robot, {o.allowNonPhysicalInertia});
   for (const std::string& w : robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   const ActuatorSet actuators = o.actuators.empty() ? defaultActuators(robot) : loadActuators(o.actuators, robot);
-  const DynamicsModel model(robot, robot.frames[0].name);
-  DynamicsData data(model);
-  forwardKinematics(model, data, Eigen::VectorXd::Zero(robot.jointCount()));
-  const Vector3 com = centerOfMass(model, data);
-
-  // Limits: actuator file over URDF (formulation.md §2).
-  auto effort = [&](int j) { return actuators.joints[j].torqueLimit; };
-  auto velocity = [&](int j) { return actuators.joints[j].velocityLimit; };
-
+  const json_io::Json info = robotInfoJson(robot, actuators);
   if (o.json) {
-    std::cout << robotInfoJson(robot, actuators).dump(2) << "\n";
+    std::cout << info.dump(2) << "\n";
     return 0;
   }
+  const auto& com = info["com"];
   std::cout << "robot " << robot.name << " (" << robot.source << ")\n"
             << "  " << robot.bodyCount() << " bodies (fixed joints merged), " << robot.frames.size()
             << " frames, " << robot.jointCount() << " actuated joints\n"
             << std::fixed << std::setprecision(3) << "  total mass " << robot.totalMass() << " kg, centre of mass at"
-            << " the zero posture (root frame) [" << com.transpose() << "] m\n\n"
+            << " the zero posture (root frame) [" << com[0].get<double>() << " " << com[1].get<double>() << " "
+            << com[2].get<double>() << "] m\n\n"
             << "  #   joint                       lower     upper    vel.max  effort.max\n";
   for (int j = 0; j < robot.jointCount(); ++j) {
     const Joint& joint = robot.joints[j];
     std::cout << "  " << std::setw(3) << std::left << j << " " << std::setw(24) << joint.name << std::right
               << std::setw(10) << joint.limits.lower << std::setw(10) << joint.limits.upper << std::setw(10)
-              << velocity(j) << std::setw(11) << effort(j) << "\n";
+              // Limits: the actuator file over the URDF (formulation.md §2).
+              << actuators.joints[j].velocityLimit << std::setw(11) << actuators.joints[j].torqueLimit << "\n";
   }
   return 0;
 }
