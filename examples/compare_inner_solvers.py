@@ -10,7 +10,9 @@ the bilevel formulation. Prints a table (status counts, mean time and iterations
 objective difference from the active-set method) and draws objective, solve time and
 iterations per sample into inner_solvers.png / .svg.
 
-    PYTHONPATH=build/release/python /usr/bin/python3 examples/compare_inner_solvers.py --out /tmp/inner
+    PYTHONPATH=build/release/python python3 examples/compare_inner_solvers.py --out inner-solvers
+
+(python3: the interpreter with Debian's numpy and matplotlib, the one the module was built for.)
 """
 import argparse
 import pathlib

@@ -18,6 +18,7 @@
 #include "python/bindings.hpp"
 #include "python/robot_handle.hpp"
 #include "study/field_path.hpp"
+#include "study/scenario_tree.hpp"
 
 namespace mcopt::python {
 
@@ -109,17 +110,6 @@ std::string refusal(const std::string& message, const std::filesystem::path& fil
   YAML::Emitter text;
   text << YAML::Flow << value;
   return file.string() + ": " + path + " = " + text.c_str() + ": the scenario refuses it: " + reason;
-}
-
-/// The scenario's tree with side-file paths absolute, so that it can be written anywhere.
-YAML::Node portableTree(const ScenarioHandle& s) {
-  YAML::Node root = YAML::Clone(s.root);
-  for (const char* key : kScenarioSideFileFields) {
-    if (!root[key] || !root[key].IsScalar()) continue;
-    const std::filesystem::path path = root[key].Scalar();
-    if (path.is_relative()) root[key] = std::filesystem::absolute(s.file.parent_path() / path).lexically_normal().string();
-  }
-  return root;
 }
 
 py::dict iterationDict(const IterationRecord& h, const MotionProblem& problem) {
@@ -239,7 +229,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
           "save",
           [](const ScenarioHandle& s, const std::filesystem::path& path) {
             YAML::Emitter out;
-            out << portableTree(s);
+            out << study::withAbsoluteSideFiles(s.root, s.file);
             writeFileAtomically(path, std::string(out.c_str()) + "\n");
           },
           py::arg("path"),

@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
 #include "outer_nlp/scenario.hpp"
+#include "study/scenario_tree.hpp"
 
 namespace mcopt::study {
 
@@ -83,14 +84,9 @@ std::string withoutScenarioLocation(const std::string& message, const std::files
 /// The base scenario with side-file paths made absolute, so that a case written elsewhere
 /// finds them.
 YAML::Node baseTree(const Sweep& sweep) {
-  YAML::Node root = yaml::loadFile(sweep.baseScenario);
+  const YAML::Node root = yaml::loadFile(sweep.baseScenario);
   if (!root.IsMap()) throw InputError(sweep.baseScenario.string() + ":1: expected a mapping of scenario fields");
-  for (const char* key : kScenarioSideFileFields) {
-    if (!root[key] || !root[key].IsScalar()) continue;
-    const std::filesystem::path path = root[key].Scalar();
-    if (path.is_relative()) root[key] = (sweep.baseScenario.parent_path() / path).lexically_normal().string();
-  }
-  return root;
+  return withAbsoluteSideFiles(root, sweep.baseScenario);
 }
 
 void apply(YAML::Node root, const FieldPath& path, const YAML::Node& value, const std::string& origin) {
