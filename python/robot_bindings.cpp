@@ -26,6 +26,18 @@ const ContactSurface& RobotHandle::surface(const std::string& name) const {
                                           : " (known: " + known + ")"));
 }
 
+namespace {
+
+/// The `name` of each element (bodies, frames, contact surfaces), in order.
+template <class Named>
+std::vector<std::string> namesOf(const std::vector<Named>& elements) {
+  std::vector<std::string> names;
+  for (const Named& e : elements) names.push_back(e.name);
+  return names;
+}
+
+}  // namespace
+
 void bindRobot(py::module_& m) {
   py::class_<RobotHandle, std::shared_ptr<RobotHandle>>(m, "Robot", R"doc(
 A robot model: a URDF (fixed joints merged, joints in URDF order) with its actuator file and
@@ -45,29 +57,17 @@ rectangles a contact can use. `allow_nonphysical_inertia` turns invalid inertias
       .def_property_readonly("joint_count", [](const RobotHandle& r) { return r.model->jointCount(); }, "number of actuated joints n")
       .def_property_readonly(
           "body_names",
-          [](const RobotHandle& r) {
-            std::vector<std::string> names;
-            for (const Body& b : r.model->bodies) names.push_back(b.name);
-            return names;
-          },
+          [](const RobotHandle& r) { return namesOf(r.model->bodies); },
           "bodies after merging fixed joints")
       .def_property_readonly(
           "frame_names",
-          [](const RobotHandle& r) {
-            std::vector<std::string> names;
-            for (const Frame& f : r.model->frames) names.push_back(f.name);
-            return names;
-          },
+          [](const RobotHandle& r) { return namesOf(r.model->frames); },
           "every URDF link, merged ones included: what reference_body and frame arguments accept")
       .def_property_readonly("total_mass", [](const RobotHandle& r) { return r.model->totalMass(); }, "[kg]")
       .def_property_readonly("warnings", [](const RobotHandle& r) { return r.model->warnings; }, "what loading accepted with a warning (allow_nonphysical_inertia)")
       .def_property_readonly(
           "contact_surfaces",
-          [](const RobotHandle& r) {
-            std::vector<std::string> names;
-            for (const ContactSurface& s : r.surfaces) names.push_back(s.name);
-            return names;
-          },
+          [](const RobotHandle& r) { return namesOf(r.surfaces); },
           "names of the contact surfaces loaded with the robot")
       .def(
           "joint_limits",
