@@ -16,5 +16,6 @@ Runner addInner(CLI::App& app);
 Runner addRun(CLI::App& app);
 Runner addStudy(CLI::App& app);
 Runner addPlot(CLI::App& app);
+Runner addReplay(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(study, mcopt::cli::addStudy(*study));
   CLI::App* plotCommand = app.add_subcommand("plot", "figures of an optimised motion (PNG and SVG, matplotlib)");
   runners.emplace_back(plotCommand, mcopt::cli::addPlot(*plotCommand));
+  CLI::App* replayCommand = app.add_subcommand("replay", "a self-contained HTML page animating an optimised motion in 3-D (three.js)");
+  runners.emplace_back(replayCommand, mcopt::cli::addReplay(*replayCommand));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {

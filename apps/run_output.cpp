@@ -57,6 +57,14 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
   result["contact_forces"] = toString(scenario.contactForces);
   result["joint_names"] = robot.jointNames();
   result["reference_body"] = scenario.referenceBody;
+  // What a result's motion is of, so that it can be drawn again (mcopt replay) from anywhere.
+  Json referencePose;
+  referencePose["position"] = toJson(scenario.referencePose.translation);
+  referencePose["quaternion_xyzw"] = toJson(quaternionXyzwFromRotation(scenario.referencePose.rotation));
+  result["reference_pose"] = referencePose;
+  result["gravity"] = toJson(scenario.gravity);
+  result["robot_files"] = {{"urdf", std::filesystem::absolute(robot.source).lexically_normal().string()},
+                           {"contact_surfaces", std::filesystem::absolute(scenario.contactSurfacesFile).lexically_normal().string()}};
   result["duration"] = T;
   Json params = Json::object();
   const int m = problem.parametrization().parametersPerJoint();

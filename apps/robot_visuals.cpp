@@ -1,0 +1,128 @@
+#include "apps/robot_visuals.hpp"
+
+#include <urdf_parser/urdf_parser.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "core/errors.hpp"
+
+namespace mcopt::cli {
+
+namespace {
+
+RigidTransform toTransform(const urdf::Pose& pose) {
+  double x, y, z, w;
+  pose.rotation.getQuaternion(x, y, z, w);
+  RigidTransform t;
+  t.rotation = Eigen::Quaterniond(w, x, y, z).normalized().toRotationMatrix();
+  t.translation = Vector3(pose.position.x, pose.position.y, pose.position.z);
+  return t;
+}
+
+/// The shape of one URDF visual, or false for a mesh (or an empty primitive).
+bool visualShape(const urdf::Visual& visual, const RigidTransform& linkInBody, VisualShape& shape) {
+  if (!visual.geometry) return false;
+  switch (visual.geometry->type) {
+    case urdf::Geometry::BOX: {
+      const auto& box = static_cast<const urdf::Box&>(*visual.geometry);
+      shape.kind = VisualShape::Kind::Box;
+      shape.size = Vector3(box.dim.x, box.dim.y, box.dim.z);
+      break;
+    }
+    case urdf::Geometry::CYLINDER: {
+      const auto& cylinder = static_cast<const urdf::Cylinder&>(*visual.geometry);
+      shape.kind = VisualShape::Kind::Cylinder;
+      shape.size = Vector3(cylinder.radius, cylinder.length, 0.0);
+      break;
+    }
+    case urdf::Geometry::SPHERE:
+      shape.kind = VisualShape::Kind::Sphere;
+      shape.size = Vector3(static_cast<const urdf::Sphere&>(*visual.geometry).radius, 0.0, 0.0);
+      break;
+    default:
+      return false;
+  }
+  if (!(shape.size.maxCoeff() > 0.0)) return false;
+  shape.placement = linkInBody * toTransform(visual.origin);
+  if (visual.material) {
+    const urdf::Color& c = visual.material->color;
+    shape.rgba = {c.r, c.g, c.b, c.a > 0.0 ? c.a : 1.0};
+  }
+  shape.source = "visual";
+  return true;
+}
+
+/// A thin cylinder from `from` to `to` (body frame), or false when they coincide.
+bool linkCylinder(const Vector3& from, const Vector3& to, double radius, VisualShape& shape) {
+  const Vector3 d = to - from;
+  const double length = d.norm();
+  if (length < 1e-4) return false;
+  shape.kind = VisualShape::Kind::Cylinder;
+  shape.size = Vector3(radius, length, 0.0);
+  shape.placement.rotation = Eigen::Quaterniond::FromTwoVectors(Vector3::UnitZ(), d / length).toRotationMatrix();
+  shape.placement.translation = 0.5 * (from + to);
+  shape.rgba = {0.35, 0.38, 0.45, 1.0};
+  shape.source = "link";
+  return true;
+}
+
+}  // namespace
+
+VisualShape inertiaBox(const BodyInertia& inertia, double minimumEdge) {
+  VisualShape box;
+  box.kind = VisualShape::Kind::Box;
+  box.source = "inertia";
+  box.placement.translation = inertia.com;
+  if (!(inertia.mass > 0.0)) {
+    box.size = Vector3::Constant(minimumEdge);
+    return box;
+  }
+  // A uniform box of edges a, b, c has I_x = m (b² + c²) / 12, …, so a² = 6 (I_y + I_z − I_x) / m.
+  const Eigen::SelfAdjointEigenSolver<Matrix3> principal(0.5 * (inertia.inertiaAboutCom + inertia.inertiaAboutCom.transpose()));
+  const Vector3 I = principal.eigenvalues();
+  Matrix3 axes = principal.eigenvectors();
+  if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
+  for (int i = 0; i < 3; ++i) {
+    const double squared = 6.0 * (I((i + 1) % 3) + I((i + 2) % 3) - I(i)) / inertia.mass;
+    box.size(i) = std::max(minimumEdge, std::sqrt(std::max(squared, 0.0)));
+  }
+  box.placement.rotation = axes;
+  return box;
+}
+
+std::vector<std::vector<VisualShape>> bodyVisualShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+  std::ifstream in(urdf);
+  if (!in) throw InputError(urdf.string() + ": cannot read the robot description");
+  std::stringstream text;
+  text << in.rdbuf();
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
+  if (!model) throw InputError(urdf.string() + ": not a URDF urdfdom can parse");
+
+  std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
+  for (const Frame& frame : robot.frames) {
+    const urdf::LinkConstSharedPtr link = model->getLink(frame.name);
+    if (!link) throw InputError(urdf.string() + ": link '" + frame.name + "' is not in the file the robot was loaded from");
+    for (const urdf::VisualSharedPtr& visual : link->visual_array) {
+      VisualShape shape;
+      if (visual && visualShape(*visual, frame.placement, shape)) shapes[static_cast<std::size_t>(frame.body)].push_back(shape);
+    }
+  }
+  for (std::size_t b = 0; b < robot.bodies.size(); ++b) {
+    if (!shapes[b].empty()) continue;
+    // Drawn from dynamics alone: the inertia box, and a cylinder to each joint the body
+    // carries (its frame's origin is its own joint's axis point).
+    shapes[b].push_back(inertiaBox(robot.bodies[b].inertia, 0.02));
+    for (const Joint& joint : robot.joints) {
+      VisualShape link;
+      if (static_cast<std::size_t>(joint.parentBody) == b && linkCylinder(Vector3::Zero(), joint.placement.translation, 0.012, link))
+        shapes[b].push_back(link);
+    }
+  }
+  return shapes;
+}
+
+}  // namespace mcopt::cli
