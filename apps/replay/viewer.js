@@ -98,10 +98,10 @@
   const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
   const controls = new THREE.OrbitControls(camera, renderer.domElement);
   {
-    // Looking at the robot's first centre of mass from its front left.
+    // Looking at the robot's first centre of mass from its front right.
     const c = scene.center_of_mass[0];
     controls.target.set(c[0], c[1], c[2]);
-    camera.position.set(c[0] + 1.6, c[1] + 2.4, c[2] + 0.6);
+    camera.position.set(c[0] + 2.3, c[1] - 1.7, c[2] + 0.6);
     controls.update();
   }
 
@@ -186,21 +186,22 @@
   document.getElementById('caption').textContent =
     `${scene.robot} · ${scene.scenario} · ${scene.status} · energy ${scene.energy.toFixed(4)} J`;
 
-  const projected = new THREE.Vector3();
+  // What is shown, for tests and scripts: the instant, the camera (so that a screenshot's
+  // pixels can be matched with world points), every body's world pose and the centre of its
+  // first shape.
   function report() {
     const size = renderer.getSize(new THREE.Vector2());
-    const state = { t, playing, frames, errors, load_ms: loadMs, width: size.x, height: size.y, bodies: {} };
-    const toScreen = (v) => { v.project(camera); return [(v.x + 1) / 2 * size.x, (1 - v.y) / 2 * size.y]; };
-    const orientation = new THREE.Quaternion();
+    const state = {
+      t, playing, frames, errors, load_ms: loadMs, width: size.x, height: size.y,
+      camera: { position: camera.position.toArray(), target: controls.target.toArray(), up: camera.up.toArray(), fov_deg: camera.fov },
+      bodies: {} };
+    const position = new THREE.Vector3(), orientation = new THREE.Quaternion(), centre = new THREE.Vector3();
     bodies.forEach(({ group }) => {
-      group.getWorldPosition(projected);
+      group.getWorldPosition(position);
       group.getWorldQuaternion(orientation);
-      const position = [projected.x, projected.y, projected.z];
-      // The centre of the body's first shape, where it is drawn.
-      const shape = group.children.length ? group.children[0].getWorldPosition(new THREE.Vector3()) : projected.clone();
+      if (group.children.length) group.children[0].getWorldPosition(centre); else centre.copy(position);
       state.bodies[group.name] = {
-        position, quaternion_xyzw: [orientation.x, orientation.y, orientation.z, orientation.w],
-        screen: toScreen(projected), shape_centre: [shape.x, shape.y, shape.z], shape_screen: toScreen(shape.clone()) };
+        position: position.toArray(), quaternion_xyzw: orientation.toArray(), shape_centre: centre.toArray() };
     });
     document.getElementById('mcopt-state').textContent = JSON.stringify(state);
   }

@@ -89,6 +89,24 @@ def body_mass_properties():
     return com, mass
 
 
+def projector(camera, width, height):
+    """World point → pixel of a canvas width × height at the top left of the screenshot, for the
+    page's perspective camera (three.js's lookAt and projection conventions)."""
+    eye, target, up = (np.array(camera[k], float) for k in ("position", "target", "up"))
+    back = (eye - target) / np.linalg.norm(eye - target)
+    right = np.cross(up, back)
+    right /= np.linalg.norm(right)
+    true_up = np.cross(back, right)
+    f = 1.0 / np.tan(np.radians(camera["fov_deg"]) / 2)
+
+    def pixel(point):
+        d = np.asarray(point, float) - eye
+        x, y, z = d @ right, d @ true_up, d @ back
+        ndc = np.array([f / (width / height) * x / -z, f * y / -z])
+        return [(ndc[0] + 1) / 2 * width, (1 - ndc[1]) / 2 * height]
+    return pixel
+
+
 def drawn_at(image, xy):
     """Whether the pixels around a screen point differ from the background."""
     x, y = int(round(xy[0])), int(round(xy[1]))
@@ -105,6 +123,8 @@ def test_two_instants_in_headless_chromium(replayed):
     views = {}
     for tag, k in (("start", 0), ("middle", middle)):
         state, image, console = open_page(page, f"#t={times[k]!r}", tmp, tag)
+        # The canvas fills the window above the 56-pixel control bar.
+        pixel = projector(state["camera"], image.shape[1], image.shape[0] - 56)
         assert console == [], "console output: " + "\n".join(console)
         assert state["errors"] == []
         assert not state["playing"], "#t= opens the page paused"
@@ -127,21 +147,25 @@ def test_two_instants_in_headless_chromium(replayed):
             com = robot_com[name]
             assert np.allclose(body["shape_centre"], position + rotation @ com, atol=1e-4), f"{tag}: {name}'s shape misplaced"
             if robot_mass[name] > 0.3:
-                assert drawn_at(image, body["shape_screen"]), f"{tag}: nothing drawn at {name}'s centre of mass"
-        # …and drawn at the pixel it projects to: the bodies that carry others have a link
-        # cylinder from their origin, so their origin is never empty space.
+                assert drawn_at(image, pixel(position + rotation @ com)), f"{tag}: nothing drawn at {name}'s centre of mass"
+        # …and drawn there: the bodies that carry others have a link cylinder from their
+        # origin, so their origin is never empty space.
         carried = [name for name in state["bodies"] if name.endswith(("LINK0", "LINK1", "LINK2", "LINK3")) or name == "BODY"]
         assert carried
         for name in carried:
-            assert drawn_at(image, state["bodies"][name]["screen"]), f"{tag}: nothing drawn at {name}'s origin"
+            assert drawn_at(image, pixel(dynamics.frame_pose(name, q)[0])), f"{tag}: nothing drawn at {name}'s origin"
+        # …and not everywhere: half a metre above the head is empty.
+        head = dynamics.frame_pose("HEAD_LINK1", q)[0]
+        assert not drawn_at(image, pixel(head + [0.0, 0.0, 0.5])), f"{tag}: something drawn above the head"
+        state["foot_pixel"] = pixel(dynamics.frame_pose("RLEG_LINK5", q)[0])
         views[tag] = (state, image)
     (start, first), (middle_state, second) = views["start"], views["middle"]
     assert first.shape == second.shape
     assert float(np.abs(first - second).max(axis=2).mean()) > 1e-3, "the two instants look the same"
     # The kicking foot moved on the screen as its pose says.
-    foot = "RLEG_LINK5"
-    moved = np.subtract(middle_state["bodies"][foot]["screen"], start["bodies"][foot]["screen"])
+    moved = np.subtract(middle_state["foot_pixel"], start["foot_pixel"])
     assert np.linalg.norm(moved) > 5.0, f"the right foot moved {moved} px"
+    assert drawn_at(second, middle_state["foot_pixel"]) and drawn_at(first, start["foot_pixel"])
 
 
 def test_without_fragment_it_plays(replayed):
