@@ -154,9 +154,10 @@ def test_two_instants_in_headless_chromium(replayed):
         assert carried
         for name in carried:
             assert drawn_at(image, pixel(dynamics.frame_pose(name, q)[0])), f"{tag}: nothing drawn at {name}'s origin"
-        # …and not everywhere: half a metre above the head is empty.
-        head = dynamics.frame_pose("HEAD_LINK1", q)[0]
-        assert not drawn_at(image, pixel(head + [0.0, 0.0, 0.5])), f"{tag}: something drawn above the head"
+        # …and not everywhere: 0.7 m to the robot's left, at its chest, is empty (in view).
+        beside = pixel(dynamics.frame_pose("CHEST_LINK1", q)[0] + [0.0, 0.7, 0.0])
+        assert 0 < beside[0] < image.shape[1] and 40 < beside[1] < image.shape[0] - 56
+        assert not drawn_at(image, beside), f"{tag}: something drawn beside the robot"
         state["foot_pixel"] = pixel(dynamics.frame_pose("RLEG_LINK5", q)[0])
         views[tag] = (state, image)
     (start, first), (middle_state, second) = views["start"], views["middle"]
