@@ -17,5 +17,6 @@ Runner addRun(CLI::App& app);
 Runner addStudy(CLI::App& app);
 Runner addPlot(CLI::App& app);
 Runner addReplay(CLI::App& app);
+Runner addReport(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(plotCommand, mcopt::cli::addPlot(*plotCommand));
   CLI::App* replayCommand = app.add_subcommand("replay", "a self-contained HTML page animating an optimised motion in 3-D (three.js)");
   runners.emplace_back(replayCommand, mcopt::cli::addReplay(*replayCommand));
+  CLI::App* reportCommand = app.add_subcommand("report", "the report's figures and tables measured on this machine, beside its own");
+  runners.emplace_back(reportCommand, mcopt::cli::addReport(*reportCommand));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {

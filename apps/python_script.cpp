@@ -1,7 +1,9 @@
 #include "apps/python_script.hpp"
 
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <filesystem>
 
@@ -17,6 +19,18 @@ std::pair<study::ChildExit, std::string> runPythonScript(const std::string& name
   std::vector<std::string> command = {pythonInterpreter(), (std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / name).string()};
   command.insert(command.end(), arguments.begin(), arguments.end());
   return study::runAndCapture(command);
+}
+
+study::ChildExit runPythonScriptAttached(const std::string& name, const std::vector<std::string>& arguments) {
+  std::vector<std::string> command = {pythonInterpreter(), (std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / name).string()};
+  command.insert(command.end(), arguments.begin(), arguments.end());
+  study::SpawnOptions options;
+  options.dieWithParent = true;
+  const pid_t child = study::spawnProcess(command, options);
+  int status = 0;
+  while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+  }
+  return study::childExit(status);
 }
 
 std::string pythonFailure(const std::string& name, const study::ChildExit& exit) {

@@ -1,6 +1,6 @@
 #pragma once
 // The figures are drawn by Python scripts with matplotlib (scripts/plot_*.py), run as child
-// processes: `mcopt plot` and `mcopt study collect`.
+// processes: `mcopt plot` and `mcopt study collect`; `mcopt report` measures with one.
 
 #include <string>
 #include <utility>
@@ -17,6 +17,10 @@ std::string pythonInterpreter();
 /// Runs scripts/NAME of the source tree with the arguments: its exit and standard output
 /// (its standard error goes to ours).
 std::pair<study::ChildExit, std::string> runPythonScript(const std::string& name, const std::vector<std::string>& arguments);
+
+/// Runs scripts/NAME with the arguments, its output and errors on ours as it goes (long
+/// scripts: `mcopt report`).
+study::ChildExit runPythonScriptAttached(const std::string& name, const std::vector<std::string>& arguments);
 
 /// Why a script's figures were not drawn, for an error line.
 std::string pythonFailure(const std::string& name, const study::ChildExit& exit);

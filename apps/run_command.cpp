@@ -14,6 +14,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/run_output.hpp"
+#include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
@@ -32,6 +33,7 @@ struct RunOptions {
   std::string configurationOptimisation;  ///< "", "on" or "off": overrides the scenario
   std::string contactForces;              ///< "", or a formulation: overrides the scenario
   int maxIterations = -1;
+  std::string innerSolver;                ///< "", or an inner solver: overrides the scenario
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
 };
 
@@ -64,7 +66,7 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 
 int runMotion(const RunOptions& o) {
   Scenario scenario = loadScenario(o.scenario);
-  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations});
+  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver});
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   MotionProblem problem(scenario);
   std::cout << "mcopt run " << o.scenario << "\n";
@@ -167,6 +169,9 @@ Runner addRun(CLI::App& command) {
                      "bilevel, splines or variables: override the scenario's contact_forces (formulation.md §9)")
       ->check(CLI::IsMember({"bilevel", "splines", "variables"}));
   command.add_option("--max-iterations", o->maxIterations, "override Ipopt's max_iter for the motion");
+  command.add_option("--inner-solver", o->innerSolver,
+                     "active-set, slsqp or ipopt: override the scenario's inner.solver (bilevel, formulation.md §7)")
+      ->check(CLI::IsMember(innerSolverNames()));
   command.add_option("--checkpoint-seconds", o->checkpointSeconds,
                      "write the current iterate (status running) at most this often; 0: every iteration, "
                      "negative: never")

@@ -3,9 +3,12 @@
 // with unit multipliers, for each `hessian:` option that evaluates one (docs/scenarios.md,
 // "Hessian and convergence"); beside it Gradient/OneContact100/hrp2 (bench_sensitivity.cpp)
 // and the whole problem's gradient and Jacobian (OuterGradient/Kick100/hrp2), the unit
-// these options are counted in. Threads: OMP_NUM_THREADS.
+// these options are counted in. OuterGradient/weight_shift/<formulation>[/<inner solver>]:
+// the same on the bundled weight shift for each contact-force formulation (formulation.md §9).
+// Threads: OMP_NUM_THREADS.
 #include <benchmark/benchmark.h>
 
+#include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 
 namespace mcopt::bench {
@@ -31,8 +34,7 @@ void outerHessian(benchmark::State& state, HessianOption option) {
   state.counters["variables"] = problem.nonlinearVariableCount();
 }
 
-void outerGradient(benchmark::State& state) {
-  const Scenario scenario = kick(HessianOption::LimitedMemory);
+void outerGradient(benchmark::State& state, const Scenario& scenario) {
   MotionProblem problem(scenario);
   Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end);
   Eigen::VectorXd gradient, jacobian;
@@ -47,7 +49,24 @@ void outerGradient(benchmark::State& state) {
 }  // namespace
 
 void registerOuterHessianBenchmarks() {
-  benchmark::RegisterBenchmark("OuterGradient/Kick100/hrp2", outerGradient)->Unit(benchmark::kMillisecond);
+  benchmark::RegisterBenchmark("OuterGradient/Kick100/hrp2", outerGradient, kick(HessianOption::LimitedMemory))
+      ->Unit(benchmark::kMillisecond);
+  // The report's Figure 5.2 "gradient" for each way of choosing the contact forces: the whole
+  // outer gradient and Jacobian of the bundled weight shift (60 samples, both soles).
+  const auto weightShift = [](ContactForces forces, const std::string& solver) {
+    Scenario scenario = loadScenario(std::filesystem::path(MCOPT_SOURCE_DIR) / "scenarios/hrp2_weight_shift.yaml");
+    scenario.contactForces = forces;
+    scenario.inner.solverName = solver;
+    return scenario;
+  };
+  for (const std::string& solver : innerSolverNames())
+    benchmark::RegisterBenchmark(("OuterGradient/weight_shift/bilevel/" + solver).c_str(), outerGradient,
+                                 weightShift(ContactForces::Bilevel, solver))
+        ->Unit(benchmark::kMillisecond);
+  for (const ContactForces forces : {ContactForces::Splines, ContactForces::Variables})
+    benchmark::RegisterBenchmark((std::string("OuterGradient/weight_shift/") + toString(forces)).c_str(), outerGradient,
+                                 weightShift(forces, "active-set"))
+        ->Unit(benchmark::kMillisecond);
   for (const HessianOption option : {HessianOption::FiniteDifferences, HessianOption::SampleDifferences})
     benchmark::RegisterBenchmark((std::string("OuterHessian/Kick100/hrp2/") + toString(option)).c_str(), outerHessian, option)
         ->Unit(benchmark::kMillisecond);

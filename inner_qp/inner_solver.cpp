@@ -1,6 +1,7 @@
 #include "inner_qp/inner_solver.hpp"
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <chrono>
 #include <sstream>
 
@@ -17,6 +18,16 @@ const char* toString(InnerStatus status) {
     case InnerStatus::Failed: return "failed";
   }
   return "failed";
+}
+
+const std::vector<std::string>& innerSolverNames() {
+  static const std::vector<std::string> names = {"active-set", "slsqp", "ipopt"};
+  return names;
+}
+
+bool isInnerSolverName(const std::string& name) {
+  const auto& names = innerSolverNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings) {

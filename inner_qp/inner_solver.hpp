@@ -68,6 +68,10 @@ std::unique_ptr<InnerSolver> makeIpoptSolver(const InnerSettings& settings = {})
 /// friction cones; allocation-free once it has seen a problem of the same size.
 std::unique_ptr<InnerSolver> makeActiveSetSolver(const InnerSettings& settings = {});
 
+/// The names makeInnerSolver knows, in the order documents list them.
+const std::vector<std::string>& innerSolverNames();
+bool isInnerSolverName(const std::string& name);
+
 /// Solver by name: "active-set", "slsqp" or "ipopt"; throws InputError otherwise.
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings = {});
 

@@ -8,6 +8,7 @@
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
+#include "inner_qp/inner_solver.hpp"
 #include "core/yaml_fields.hpp"
 
 namespace mcopt {
@@ -282,7 +283,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
   yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance"});
   if (node["solver"]) {
     const std::string name = yaml::text(file, node["solver"], "inner.solver");
-    if (name != "active-set" && name != "slsqp" && name != "ipopt")
+    if (!isInnerSolverName(name))
       throw InputError(where(file, node["solver"], "inner.solver") + "unknown inner solver '" + name +
                        "' (expected active-set, slsqp or ipopt)");
     s.inner.solverName = name;

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "core/errors.hpp"
+#include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/configuration_problem.hpp"
 
 namespace mcopt {
@@ -46,6 +47,11 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
   else if (!o.configurationOptimisation.empty())
     throw InputError("configuration_optimisation: expected on or off, got '" + o.configurationOptimisation + "'");
   if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
+  if (!o.innerSolver.empty()) {
+    if (!isInnerSolverName(o.innerSolver))
+      throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected active-set, slsqp or ipopt)");
+    scenario.inner.solverName = o.innerSolver;
+  }
   if (o.maxIterations >= 0) {
     SolverOption limit;
     limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;

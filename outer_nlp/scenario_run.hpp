@@ -21,6 +21,7 @@ struct ScenarioOverrides {
   std::string configurationOptimisation;  ///< "", "on" or "off"
   std::string contactForces;              ///< "", or a formulation name (formulation.md §9)
   int maxIterations = -1;                 ///< Ipopt's max_iter for the motion; < 0: the scenario's
+  std::string innerSolver;                ///< "", or an inner solver name (bilevel, formulation.md §7)
 };
 
 /// Applies the overrides; throws InputError for a value that is not one of the choices.

@@ -518,3 +518,23 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
   CHECK(r.exitCode == 2);
   CHECK_THAT(r.errors, Contains(bad.string() + ": contacts[0].wrenches[0]"));
 }
+
+TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][run][multi-contact]") {
+  const test::TempDir dir;
+  const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["hessian"] = "limited-memory";
+  }, "weight_shift.yaml");
+  for (const char* solver : {"slsqp", "active-set"}) {
+    const auto out = dir.path() / solver;
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --contact-forces bilevel --inner-solver " + solver +
+                                  " --out " + test::quoted(out) + " --max-iterations 0 --configuration-optimisation off");
+    INFO(r.all());
+    REQUIRE(r.exitCode == 4);
+    CHECK(readJson(out / "result.json")["inner"]["solver"] == solver);
+  }
+  const auto refused = test::runMcopt("run " + test::quoted(scenario) + " --inner-solver fsqp --out " + test::quoted(dir.path() / "no"));
+  CHECK(refused.exitCode != 0);
+  CHECK_THAT(refused.errors, Contains("--inner-solver"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "no"));
+}
