@@ -91,8 +91,10 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     for (HessianWorkspace& h : hessianWorkspaces_) {
       h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
-      h.local.setZero(largestLocal, largestLocal), h.columns.reserve(static_cast<std::size_t>(largestLocal));
     }
+    localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
+    for (LocalHessian& l : localHessians_)
+      l.values.setZero(largestLocal, largestLocal), l.columns.reserve(static_cast<std::size_t>(largestLocal));
     probes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
@@ -110,10 +112,9 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     HessianWorkspace& h = hessianWorkspaces_[static_cast<std::size_t>(t)];
     SampleBlock& probe = probes_[static_cast<std::size_t>(t)];
     SampleBlock& taskProbe = taskProbes_[static_cast<std::size_t>(t)];
-    h.sum.setZero(curved, curved);
     h.probeX = x;
 
-    // Adds Bᵀ H B to the thread's sum: B maps the local spline parameters (k per joint, their
+    // Writes Bᵀ H B into the slot's LocalHessian: B maps the local spline parameters (k per joint, their
     // weights in q, q̇ = (1/T) dq/du, q̈ = (1/T²) d²q/du²) and the force columns to the state.
     const bool convex = scenario_.hessian == HessianOption::ConvexSampleDifferences;
     // Symmetrises the leading d × d block of the state Hessian (and, for the convex option,
@@ -128,7 +129,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                     h.eigen.eigenvectors().transpose();
     };
     auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
-                      const std::vector<int>& forceColumns) {
+                      const std::vector<int>& forceColumns, LocalHessian& out) {
       const int k = weights.count, nf = static_cast<int>(forceColumns.size()), d = stateBlocks * n + nf;
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
@@ -144,18 +145,16 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         for (int l = 0; l < k; ++l)
           for (int block = 0; block < stateBlocks; ++block) HB.col(j * k + l) += weight(block, l) * H.col(block * n + j);
       for (int f = 0; f < nf; ++f) HB.col(n * k + f) = H.col(stateBlocks * n + f);
-      auto BHB = h.local.topLeftCorner(local, local);  // Bᵀ H B
+      auto BHB = out.values.topLeftCorner(local, local);  // Bᵀ H B
       BHB.setZero();
       for (int j = 0; j < n; ++j)
         for (int l = 0; l < k; ++l)
           for (int block = 0; block < stateBlocks; ++block) BHB.row(j * k + l) += weight(block, l) * HB.row(block * n + j);
       for (int f = 0; f < nf; ++f) BHB.row(n * k + f) = HB.row(stateBlocks * n + f);
-      h.columns.resize(static_cast<std::size_t>(local));
-      for (int c = 0; c < n * k; ++c) h.columns[static_cast<std::size_t>(c)] = parameters[c];
-      for (int f = 0; f < nf; ++f) h.columns[static_cast<std::size_t>(n * k + f)] = forceColumns[static_cast<std::size_t>(f)];
-      for (int r = 0; r < local; ++r)
-        for (int c = 0; c < local; ++c)
-          h.sum(h.columns[static_cast<std::size_t>(r)], h.columns[static_cast<std::size_t>(c)]) += BHB(r, c);
+      out.size = local;
+      out.columns.resize(static_cast<std::size_t>(local));
+      for (int c = 0; c < n * k; ++c) out.columns[static_cast<std::size_t>(c)] = parameters[c];
+      for (int f = 0; f < nf; ++f) out.columns[static_cast<std::size_t>(n * k + f)] = forceColumns[static_cast<std::size_t>(f)];
     };
 
 #pragma omp for schedule(static)
@@ -184,12 +183,14 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       // leave it at the unperturbed state.
       if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
-      spread(samples_.weights(s), b.parameters, 3, b.forceColumns);
+      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)]);
     }
 
 #pragma omp for schedule(static)
     for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
       const auto lambda = taskMultipliers_.col(i);
+      LocalHessian& slot = localHessians_[blocks_.size() + static_cast<std::size_t>(i)];
+      slot.size = 0;
       if ((lambda.array() == 0.0).all()) continue;  // no bounded component
       const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
       // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
@@ -211,12 +212,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       symmetrise(d);
-      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {});
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot);
     }
   }
 
-  Eigen::MatrixXd& hessian = hessianWorkspaces_.front().sum;
-  for (std::size_t t = 1; t < hessianWorkspaces_.size(); ++t) hessian += hessianWorkspaces_[t].sum;
+  // Summed in sample order, whatever thread computed each term: the same Hessian, to the
+  // bit, for any thread count (docs/scenarios.md, "Determinism").
+  Eigen::MatrixXd& hessian = hessianSum_;
+  hessian.setZero(curved, curved);
+  for (const LocalHessian& l : localHessians_)
+    for (int r = 0; r < l.size; ++r)
+      for (int c = 0; c < l.size; ++c)
+        hessian(l.columns[static_cast<std::size_t>(r)], l.columns[static_cast<std::size_t>(c)]) += l.values(r, c);
 
   if (durationIsFree()) {
     // The duration's row and column: a forward difference of the whole gradient.

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -20,6 +21,9 @@ namespace mcopt {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Samples a thread evaluates in order, warm-starting each bilevel sample from the one before
+/// on the first evaluation: fixed, so that no result depends on the thread count.
+constexpr int kWarmStartChunk = 8;
 
 std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInstant) {
   // Instants are fractions of the motion: with a free duration a task keeps its phase.
@@ -553,19 +557,23 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   parametrization_.controlPoints(x.head(parameterCount_), controlPoints_);
   const int count = samples_.sampleCount(), taskCount = static_cast<int>(taskBlocks_.size());
   const int threads = static_cast<int>(workspaces_.size());
+  // Fixed chunks of consecutive samples, each evaluated in order by one thread: a bilevel
+  // sample without a result of its own (the first evaluation) is warm-started from its
+  // predecessor in the chunk. The chunks, not the thread count, decide every warm start, so
+  // the results are the same, to the bit, for any thread count (docs/scenarios.md, "Determinism").
+  const int chunks = (count + kWarmStartChunk - 1) / kWarmStartChunk;
 #pragma omp parallel num_threads(threads)
   {
-    // One contiguous block of samples per thread: a bilevel sample without a result of its
-    // own (the first evaluation) is warm-started from its predecessor in the block.
-    const int t = omp_get_thread_num(), used = omp_get_num_threads();
-    const int first = count * t / used, last = count * (t + 1) / used;
-    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(t)];
-    for (int s = first; s < last; ++s) {
-      if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
-        bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
-      evaluateSample(s, x, T, derivatives, w);
+    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+    for (int chunk = 0; chunk < chunks; ++chunk) {
+      const int first = chunk * kWarmStartChunk, last = std::min(count, first + kWarmStartChunk);
+      for (int s = first; s < last; ++s) {
+        if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
+          bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
+        evaluateSample(s, x, T, derivatives, w);
+      }
     }
-#pragma omp barrier
 #pragma omp for schedule(static)
     for (int i = 0; i < taskCount; ++i) evaluateTaskInstant(i, T, derivatives, w);
   }

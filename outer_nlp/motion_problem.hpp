@@ -217,9 +217,15 @@ class MotionProblem final : public NlpProblem {
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
     Eigen::VectorXd probeX, weights, base, gradient;
-    Eigen::MatrixXd stateHessian, spread, local, sum;
+    Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
-    std::vector<int> columns;
+  };
+  /// One sample's (or task instant's) Bᵀ H B over its own columns: kept apart and summed in
+  /// sample order afterwards, so that the Hessian does not depend on the thread count.
+  struct LocalHessian {
+    Eigen::MatrixXd values;    ///< leading size × size block used
+    std::vector<int> columns;  ///< the NLP variable of each row and column
+    int size = 0;
   };
   void sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                 const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values);
@@ -262,6 +268,8 @@ class MotionProblem final : public NlpProblem {
   std::vector<SampleBlock> blocks_, taskBlocks_;
   std::vector<ThreadWorkspace> workspaces_;
   std::vector<HessianWorkspace> hessianWorkspaces_;
+  std::vector<LocalHessian> localHessians_;  ///< samples, then task instants
+  Eigen::MatrixXd hessianSum_;
   std::vector<SampleBlock> probes_, taskProbes_;  ///< per thread: outputs at a perturbed state
   Eigen::MatrixXd sampleMultipliers_, taskMultipliers_;  ///< per output × sample / task instant
   Eigen::MatrixXd controlPoints_;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "common/run_command.hpp"
+#include "common/scenario_variant.hpp"
 #include "common/temp_dir.hpp"
 #include "common/test_support.hpp"
 
@@ -29,15 +30,10 @@ std::string readText(const std::filesystem::path& file) {
 
 /// A kick of 8 samples optimised for 4 iterations, in dir/run.
 std::filesystem::path smallKick(const test::TempDir& dir) {
-  const std::filesystem::path kick = test::sourceDir() / "scenarios/hrp2_kick.yaml";
-  YAML::Node root = YAML::LoadFile(kick.string());
-  for (const char* key : {"robot", "actuators", "contact_surfaces", "postures"})
-    root[key] = (kick.parent_path() / root[key].as<std::string>()).lexically_normal().string();
-  root["samples"] = 8;
-  root["output_samples"] = 40;
-  YAML::Emitter emitter;
-  emitter << root;
-  const auto scenario = dir.write("kick.yaml", emitter.c_str());
+  const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_kick.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["output_samples"] = 40;
+  }, "kick.yaml");
   const auto out = dir.path() / "run";
   const auto run = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) +
                                   " --configuration-optimisation off --max-iterations 4");

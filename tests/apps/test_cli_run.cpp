@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/run_command.hpp"
+#include "common/scenario_variant.hpp"
 #include "common/temp_dir.hpp"
 #include "common/test_support.hpp"
 #include "core/actuators.hpp"
@@ -29,16 +30,7 @@ constexpr bool kUnderSanitizers = false;
 #endif
 
 /// A bundled scenario with its side files made absolute, then `edit` applied, written to dir.
-std::filesystem::path scenarioVariant(const std::filesystem::path& source, const test::TempDir& dir,
-                                      const std::function<void(YAML::Node&)>& edit, const std::string& name) {
-  YAML::Node root = YAML::LoadFile(source.string());
-  for (const char* key : {"robot", "actuators", "contact_surfaces", "postures"})
-    root[key] = (source.parent_path() / root[key].as<std::string>()).lexically_normal().string();
-  edit(root);
-  YAML::Emitter out;
-  out << root;
-  return dir.write(name, std::string(out.c_str()) + "\n");
-}
+using test::scenarioVariant;
 
 std::filesystem::path kickVariant(const test::TempDir& dir, const std::function<void(YAML::Node&)>& edit,
                                   const std::string& name = "scenario.yaml") {

@@ -1,0 +1,115 @@
+// Determinism (issue 19, docs/scenarios.md "Determinism"): the same input gives the same
+// output, to the bit, with 1 and 2 OpenMP threads and from run to run — every number of
+// result.json but the clocks', and every side file byte for byte.
+#include <yaml-cpp/yaml.h>
+
+#include <catch2/catch.hpp>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "common/run_command.hpp"
+#include "common/scenario_variant.hpp"
+#include "common/temp_dir.hpp"
+#include "common/test_support.hpp"
+
+using namespace mcopt;
+using Json = nlohmann::json;
+
+namespace {
+
+// Under AddressSanitizer the executable runs ~10× slower: smaller problems, the same checks.
+#ifdef MCOPT_UNDER_SANITIZERS
+constexpr bool kUnderSanitizers = true;
+#else
+constexpr bool kUnderSanitizers = false;
+#endif
+
+std::string readText(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+/// result.json without the clocks' readings (and the folder it was written to).
+Json withoutClocks(const std::filesystem::path& out) {
+  Json r = Json::parse(readText(out / "result.json"));
+  r.erase("timings");
+  for (Json& line : r["history"]) {
+    line.erase("elapsed_seconds");
+    line.erase("seconds");
+    if (line.contains("inner")) line["inner"].erase("solve_seconds");
+  }
+  for (Json& stage : r["continuation"]) stage.erase("seconds");
+  for (const char* end : {"start", "end"})
+    if (r["configuration_optimisation"].contains(end)) r["configuration_optimisation"][end].erase("seconds");
+  return r;
+}
+
+/// Runs `mcopt run` with 1 thread, 2 threads and 2 threads again, and compares.
+void sameWithAnyThreads(const test::TempDir& dir, const std::filesystem::path& scenario, const std::string& arguments) {
+  std::vector<std::filesystem::path> outs;
+  for (const char* threads : {"1", "2", "2"}) {
+    const auto out = dir.path() / ("run-" + std::to_string(outs.size()));
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " " + arguments,
+                                  std::string("OMP_NUM_THREADS=") + threads);
+    INFO(r.all());
+    REQUIRE((r.exitCode == 0 || r.exitCode == 4));
+    outs.push_back(out);
+  }
+  const Json one = withoutClocks(outs[0]), two = withoutClocks(outs[1]), again = withoutClocks(outs[2]);
+  CHECK(one["solver"]["iterations"].get<int>() > 0);
+  for (const auto& [key, value] : one.items()) {
+    INFO("result.json field " << key);
+    CHECK(value == two[key]);    // 1 thread against 2
+    CHECK(two[key] == again[key]);  // run to run
+  }
+  for (const char* file : {"trajectory.csv", "states.json", "contact_wrenches.json"}) {
+    INFO(file);
+    CHECK(readText(outs[0] / file) == readText(outs[1] / file));
+    CHECK(readText(outs[1] / file) == readText(outs[2] / file));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("determinism: the kick, configuration optimisation and Newton steps, with 1 and 2 threads", "[cli][determinism]") {
+  const test::TempDir dir;
+  const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_kick.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = kUnderSanitizers ? 10 : 24;
+    root["output_samples"] = 50;
+  }, "kick.yaml");
+  sameWithAnyThreads(dir, scenario, "--max-iterations 5 --checkpoint-seconds -1");
+}
+
+TEST_CASE("determinism: the bilevel weight shift, inner solves warm-started, with 1 and 2 threads", "[cli][determinism]") {
+  const test::TempDir dir;
+  const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = kUnderSanitizers ? 8 : 20;
+  }, "weight_shift.yaml");
+  sameWithAnyThreads(dir, scenario, "--contact-forces bilevel --inner-solver active-set --max-iterations 3 --checkpoint-seconds -1");
+}
+
+TEST_CASE("determinism: mcopt inner with 1 and 2 threads and from run to run", "[cli][determinism]") {
+  // A motion's inner problems (two soles, then a hand as well): the fuzz seed, reused.
+  const auto problems = test::sourceDir() / "tests/fuzz/corpus/inner_problems/two_soles_then_hand.json";
+  const test::TempDir dir;
+  // NLopt 2.7.1's SLSQP reads memory it never initialised (valgrind: inside nlopt_slsqp), so
+  // its iterations differ from run to run: docs/inner-problem.md, "Determinism".
+  for (const char* solver : {"active-set", "ipopt"}) {
+    std::vector<Json> outputs;
+    for (const char* threads : {"1", "2", "2"}) {
+      const auto out = dir.path() / (std::string(solver) + "-" + std::to_string(outputs.size()) + ".json");
+      const auto r = test::runMcopt("inner --problems " + test::quoted(problems) + " --solver " + solver + " --sensitivity --out " +
+                                    test::quoted(out), std::string("OMP_NUM_THREADS=") + threads);
+      INFO(r.all());
+      REQUIRE(r.exitCode == 0);
+      Json output = Json::parse(readText(out));
+      for (Json& result : output["results"]) result.erase("solve_time_us");
+      outputs.push_back(output);
+    }
+    INFO(solver);
+    CHECK(outputs[0]["results"].size() == 3);
+    CHECK(outputs[0] == outputs[1]);
+    CHECK(outputs[1] == outputs[2]);
+  }
+}
