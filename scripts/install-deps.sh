@@ -18,6 +18,7 @@ packages=(
   slurm-wlm munge          # studies as Slurm job arrays; scripts/slurm-local.sh and its test
   libjs-three              # three.js, inlined into the pages of `mcopt replay` (docs/replay.md)
   chromium                 # headless browser of the replay's test
+  clang libclang-rt-14-dev libomp-14-dev   # the libFuzzer targets (scripts/fuzz.sh, docs/fuzzing.md)
 )
 
 missing=()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the dependencies, then builds and runs the whole test suite twice:
 # Release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer.
-# Set MCOPT_SKIP_SANITIZE=1 to run only the first.
+# Then each libFuzzer target briefly (scripts/fuzz.sh, docs/fuzzing.md): MCOPT_FUZZ_SECONDS a
+# target (default 20; 0 skips). Set MCOPT_SKIP_SANITIZE=1 to run only the first.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(nproc)"
@@ -16,4 +17,9 @@ if [ "${MCOPT_SKIP_SANITIZE:-0}" != "1" ]; then
   cmake --build "$root/build/sanitize" --parallel "$jobs"
   (cd "$root/build/sanitize" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
      ctest --output-on-failure --parallel "$jobs")
+fi
+
+fuzz_seconds="${MCOPT_FUZZ_SECONDS:-20}"
+if [ "$fuzz_seconds" != "0" ]; then
+  "$root/scripts/fuzz.sh" "$fuzz_seconds"
 fi
