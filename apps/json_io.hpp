@@ -19,7 +19,9 @@ inline Json readFile(const std::filesystem::path& path) {
   if (!in) throw InputError(path.string() + ": cannot open (missing or unreadable)");
   try {
     return Json::parse(in);
-  } catch (const Json::parse_error& e) {
+  } catch (const Json::exception& e) {
+    // parse_error, and out_of_range for a number beyond a double (1e99999: found by fuzzing,
+    // tests/fuzz/regressions/).
     throw InputError(path.string() + ": malformed JSON: " + e.what());
   }
 }

@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <fstream>
+#include <algorithm>
 #include <functional>
 #include <mutex>
 #include <set>
@@ -202,6 +203,15 @@ RobotModel buildModel(const urdf::ModelInterface& urdfModel, const std::string& 
         }
       };
   visit(*root, 0, RigidTransform::identity());
+  // Every link must hang from the root: urdfdom accepts links whose joints form a loop apart
+  // from it (found by fuzzing, tests/fuzz/regressions/), and they would be silently missing.
+  if (model.frames.size() != urdfModel.links_.size()) {
+    std::string missing;
+    for (const auto& [name, link] : urdfModel.links_)
+      if (std::none_of(model.frames.begin(), model.frames.end(), [&](const Frame& f) { return f.name == name; }))
+        missing += (missing.empty() ? "" : ", ") + name;
+    throw InputError(source + ": links not connected to the root link '" + root->name + "' (their joints form a loop): " + missing);
+  }
   return model;
 }
 
@@ -226,6 +236,14 @@ RobotModel loadUrdfString(const std::string& xml, const std::string& sourceName,
     if (why.empty()) why = "malformed URDF";
     throw InputError(sourceName + ": not a valid URDF: " + why);
   }
+  // urdfdom links parents and children by shared pointers: a kinematic loop in the file (which
+  // it accepts) would keep its links alive for ever. Unlink them once the model is read.
+  struct Unlink {
+    urdf::ModelInterface& model;
+    ~Unlink() {
+      for (auto& [name, link] : model.links_) link->child_links.clear(), link->child_joints.clear();
+    }
+  } unlink{*parsed};
   return buildModel(*parsed, sourceName, options);
 }
 

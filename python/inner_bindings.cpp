@@ -77,6 +77,8 @@ Json jsonOf(const py::object& value, const std::string& what) {
     return Json::parse(text);
   } catch (const py::error_already_set& e) {
     throw py::value_error(std::string(kOrigin) + ": " + what + ": " + std::string(py::str(e.value())));
+  } catch (const Json::exception& e) {  // an integer beyond a double (10**400)
+    throw py::value_error(std::string(kOrigin) + ": " + what + ": " + e.what());
   }
 }
 

@@ -120,6 +120,10 @@ TEST_CASE("dynamics: bad input gets a clear error and a non-zero exit", "[cli][i
   CHECK_THAT(r.errors, Contains("unknown body 'no_such_link'"));
   r = run(R"({"states": [ )");
   CHECK_THAT(r.errors, Contains("malformed JSON"));
+  // A number beyond a double is a malformed file too, not an internal error (found by fuzzing).
+  r = run(R"({"states": [{"q": [5e99999]}]})");
+  CHECK(r.exitCode == 2);
+  CHECK_THAT(r.errors, Contains("in.json: malformed JSON") && Contains("number overflow"));
   r = test::runMcopt("dynamics --robot " + test::quoted(dir.write("bad.urdf", "<robot")) + " --states x.json");
   CHECK(r.exitCode == 2);
   CHECK_THAT(r.errors, Contains("bad.urdf") && Contains("not a valid URDF"));

@@ -82,6 +82,12 @@ TEST_CASE("URDF errors name the file and the element", "[input][urdf]") {
                                      "loop.urdf"),
                       Contains("loop.urdf"));
   }
+  SECTION("links whose joints form a loop apart from the root are rejected, not dropped (found by fuzzing)") {
+    // b → c → b hangs from nothing: urdfdom accepts it, with 'a' as the root.
+    CHECK_THROWS_WITH(loadUrdfString(robot(urdfLink("a") + urdfLink("b") + urdfLink("c") + joint("j1", "b", "c") + joint("j2", "c", "b")),
+                                     "cycle.urdf"),
+                      Contains("cycle.urdf: links not connected to the root link 'a' (their joints form a loop): b, c"));
+  }
   SECTION("unknown body") {
     const RobotModel model = loadUrdfString(kGood, "good.urdf");
     CHECK_THROWS_WITH(DynamicsModel(model, "no_such_link"), Contains("good.urdf") && Contains("unknown body 'no_such_link'"));
