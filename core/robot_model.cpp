@@ -207,9 +207,9 @@ RobotModel buildModel(const urdf::ModelInterface& urdfModel, const std::string& 
   // from it (found by fuzzing, tests/fuzz/regressions/), and they would be silently missing.
   if (model.frames.size() != urdfModel.links_.size()) {
     std::string missing;
-    for (const auto& [name, link] : urdfModel.links_)
-      if (std::none_of(model.frames.begin(), model.frames.end(), [&](const Frame& f) { return f.name == name; }))
-        missing += (missing.empty() ? "" : ", ") + name;
+    for (const auto& entry : urdfModel.links_)
+      if (std::none_of(model.frames.begin(), model.frames.end(), [&](const Frame& f) { return f.name == entry.first; }))
+        missing += (missing.empty() ? "" : ", ") + entry.first;
     throw InputError(source + ": links not connected to the root link '" + root->name + "' (their joints form a loop): " + missing);
   }
   return model;
