@@ -41,9 +41,7 @@ void readJoint(const std::filesystem::path& file, const YAML::Node& node, const 
     a.velocityLimit = yaml::positive(file, node["velocity_limit"], field + ".velocity_limit");
 }
 
-}  // namespace
-
-ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& robot) {
+ActuatorSet readActuators(const std::filesystem::path& path, const RobotModel& robot) {
   const YAML::Node root = yaml::loadFile(path);
   yaml::rejectUnknownKeys(path, root, "", {"friction_sharpness", "defaults", "joints", "sources"});
   ActuatorSet set = defaultActuators(robot);
@@ -63,6 +61,8 @@ ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& r
   }
   return set;
 }
+
+}  // namespace
 
 double frictionTorque(const ActuatorParameters& actuator, double motorSpeed, double sharpness) {
   return actuator.viscousFriction * motorSpeed +
@@ -99,6 +99,10 @@ MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, 
   d.dVelocity = n * p.motorTorque + dPdMotorTorque * n * frictionSlope;
   d.dAcceleration = dPdMotorTorque * actuator.rotorInertia * n;
   return d;
+}
+
+ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& robot) {
+  return yaml::reading(path, [&] { return readActuators(path, robot); });
 }
 
 }  // namespace mcopt

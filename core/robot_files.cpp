@@ -4,7 +4,9 @@
 
 namespace mcopt {
 
-std::vector<ContactSurface> loadContactSurfaces(const std::filesystem::path& path, const RobotModel& robot) {
+namespace {
+
+std::vector<ContactSurface> readContactSurfaces(const std::filesystem::path& path, const RobotModel& robot) {
   const YAML::Node root = yaml::loadFile(path);
   yaml::rejectUnknownKeys(path, root, "", {"contact_surfaces", "sources"});
   const YAML::Node surfaces = yaml::required(path, root, "contact_surfaces", "");
@@ -46,7 +48,7 @@ std::vector<ContactSurface> loadContactSurfaces(const std::filesystem::path& pat
   return out;
 }
 
-std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path& path, const RobotModel& robot) {
+std::map<std::string, Eigen::VectorXd> readPostures(const std::filesystem::path& path, const RobotModel& robot) {
   const YAML::Node root = yaml::loadFile(path);
   yaml::rejectUnknownKeys(path, root, "", {"postures", "sources"});
   const YAML::Node postures = yaml::required(path, root, "postures", "");
@@ -69,6 +71,16 @@ std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path&
     out.emplace(name, q);
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<ContactSurface> loadContactSurfaces(const std::filesystem::path& path, const RobotModel& robot) {
+  return yaml::reading(path, [&] { return readContactSurfaces(path, robot); });
+}
+
+std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path& path, const RobotModel& robot) {
+  return yaml::reading(path, [&] { return readPostures(path, robot); });
 }
 
 Eigen::VectorXd postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,

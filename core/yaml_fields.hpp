@@ -20,6 +20,19 @@ inline std::string where(const std::filesystem::path& file, const YAML::Node& no
   return file.string() + ":" + std::to_string(line) + ": " + field + ": ";
 }
 
+/// Runs `read`, a reader of `file`: what yaml-cpp throws on a node of a kind the reader did not
+/// expect (a key that is a list, found by fuzzing: tests/fuzz/regressions/) becomes an
+/// InputError at that node's line, never an internal error.
+template <class Read>
+auto reading(const std::filesystem::path& file, Read&& read) {
+  try {
+    return read();
+  } catch (const YAML::Exception& e) {
+    const int line = e.mark.is_null() ? 0 : e.mark.line + 1;
+    throw InputError(file.string() + ":" + std::to_string(line) + ": " + (e.msg.empty() ? std::string("malformed YAML") : e.msg));
+  }
+}
+
 inline YAML::Node loadFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": file not found");
   try {
@@ -33,6 +46,7 @@ inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Nod
                               std::initializer_list<const char*> allowed) {
   if (!map.IsMap()) throw InputError(where(file, map, field) + "expected a mapping");
   for (const auto& entry : map) {
+    if (!entry.first.IsScalar()) throw InputError(where(file, entry.first, field) + "a key must be a name, not a list or mapping");
     const std::string key = entry.first.as<std::string>();
     bool known = false;
     std::string list;

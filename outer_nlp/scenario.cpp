@@ -309,6 +309,8 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
     }
   }
 }
+Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file);
+
 }  // namespace
 
 const char* toString(ContactForces forces) {
@@ -354,6 +356,12 @@ HessianOption parseHessianOption(const std::string& name) {
 Scenario loadScenario(const std::filesystem::path& file) { return loadScenario(yaml::loadFile(file), file); }
 
 Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file) {
+  return yaml::reading(file, [&] { return readScenario(root, file); });
+}
+
+namespace {
+
+Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
   yaml::rejectUnknownKeys(file, root, "",
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
@@ -538,6 +546,8 @@ Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file)
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   return s;
 }
+
+}  // namespace
 
 Scenario continuationStage(const Scenario& scenario, std::size_t k) {
   Scenario stage = scenario;

@@ -149,6 +149,14 @@ TEST_CASE("actuator, contact and posture files: errors name file, line and field
     const auto nan = dir.write("nan.yaml", "joints:\n  shoulder:\n    gear_ratio: .nan\n");
     CHECK_THROWS_WITH(loadActuators(nan, model), Contains("nan.yaml:3") && Contains("finite"));
   }
+  SECTION("a key that is a list or a mapping, not a name (found by fuzzing)") {
+    const auto top = dir.write("key.yaml", "joints:\n  shoulder: {gear_ratio: 100}\n[a, b]: 1\n");
+    CHECK_THROWS_WITH(loadActuators(top, model), Contains("key.yaml:3") && Contains("a key must be a name"));
+    const auto inner = dir.write("joint.yaml", "joints:\n  ? {x: 1}\n  : {gear_ratio: 100}\n");
+    CHECK_THROWS_WITH(loadActuators(inner, model), Contains("joint.yaml:2"));
+    const auto posture = dir.write("p.yaml", "postures:\n  bent: {[shoulder]: 0.3}\n");
+    CHECK_THROWS_WITH(loadPostures(posture, model), Contains("p.yaml:2"));
+  }
   SECTION("malformed YAML") {
     const auto file = dir.write("bad.yaml", "joints: [unclosed\n");
     CHECK_THROWS_WITH(loadActuators(file, model), Contains("bad.yaml") && Contains("malformed YAML"));
