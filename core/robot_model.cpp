@@ -4,8 +4,9 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <Eigen/Eigenvalues>
-#include <fstream>
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <mutex>
 #include <set>
@@ -248,6 +249,7 @@ RobotModel loadUrdfString(const std::string& xml, const std::string& sourceName,
 }
 
 RobotModel loadUrdfFile(const std::filesystem::path& path, const UrdfOptions& options) {
+  if (std::filesystem::exists(path) && !std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": not a file");
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open URDF file (missing or unreadable)");
   std::stringstream content;

@@ -35,6 +35,8 @@ auto reading(const std::filesystem::path& file, Read&& read) {
 
 inline YAML::Node loadFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": file not found");
+  // A folder named as a file makes the stream throw ios_base::failure (found by fuzzing).
+  if (!std::filesystem::is_regular_file(file)) throw InputError(file.string() + ": not a file");
   try {
     return YAML::LoadFile(file.string());
   } catch (const YAML::Exception& e) {

@@ -157,6 +157,10 @@ TEST_CASE("actuator, contact and posture files: errors name file, line and field
     const auto posture = dir.write("p.yaml", "postures:\n  bent: {[shoulder]: 0.3}\n");
     CHECK_THROWS_WITH(loadPostures(posture, model), Contains("p.yaml:2"));
   }
+  SECTION("a folder where a file is named (found by fuzzing)") {
+    CHECK_THROWS_WITH(loadContactSurfaces(dir.path(), model), Contains(dir.path().string() + ": not a file"));
+    CHECK_THROWS_WITH(loadUrdfFile(dir.path()), Contains(dir.path().string() + ": not a file"));
+  }
   SECTION("malformed YAML") {
     const auto file = dir.write("bad.yaml", "joints: [unclosed\n");
     CHECK_THROWS_WITH(loadActuators(file, model), Contains("bad.yaml") && Contains("malformed YAML"));
