@@ -5,6 +5,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/text_encoding.hpp"
 
 namespace mcopt {
 
@@ -219,6 +221,13 @@ RobotModel buildModel(const urdf::ModelInterface& urdfModel, const std::string& 
 }  // namespace
 
 RobotModel loadUrdfString(const std::string& xml, const std::string& sourceName, const UrdfOptions& options) {
+  // XML without an encoding declaration is UTF-8, and names go on to JSON (text_encoding.hpp).
+  if (const auto fault = firstInvalidUtf8(xml)) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", fault->byte);
+    throw InputError(sourceName + ":" + std::to_string(fault->line) + ": not valid UTF-8 (byte " + hex +
+                     "); mcopt reads URDF files as UTF-8");
+  }
   // console_bridge's output handler is global: serialise loads.
   static std::mutex parseMutex;
   std::lock_guard<std::mutex> lock(parseMutex);

@@ -5,12 +5,17 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
+#include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/text_encoding.hpp"
 
 namespace mcopt::yaml {
 
@@ -37,8 +42,23 @@ inline YAML::Node loadFile(const std::filesystem::path& file) {
   if (!std::filesystem::exists(file)) throw InputError(file.string() + ": file not found");
   // A folder named as a file makes the stream throw ios_base::failure (found by fuzzing).
   if (!std::filesystem::is_regular_file(file)) throw InputError(file.string() + ": not a file");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file.string() + ": cannot open (unreadable)");
+  std::stringstream content;
+  content << in.rdbuf();
+  const std::string text = content.str();
+  // yaml-cpp passes stray bytes of a UTF-8 file through to names, which JSON cannot hold
+  // (text_encoding.hpp). A UTF-16/32 file starts with a byte-order mark or a zero byte
+  // (YAML 1.2 §5.2) and yaml-cpp transcodes it itself.
+  const bool wideEncoding = !text.empty() && (text[0] == '\0' || static_cast<unsigned char>(text[0]) == 0xFEu ||
+                                              static_cast<unsigned char>(text[0]) == 0xFFu || (text.size() > 1 && text[1] == '\0'));
+  if (const auto fault = wideEncoding ? std::nullopt : firstInvalidUtf8(text)) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", fault->byte);
+    throw InputError(file.string() + ":" + std::to_string(fault->line) + ": not valid UTF-8 (byte " + hex + ")");
+  }
   try {
-    return YAML::LoadFile(file.string());
+    return YAML::Load(text);
   } catch (const YAML::Exception& e) {
     throw InputError(file.string() + ":" + std::to_string(e.mark.line + 1) + ": malformed YAML: " + e.msg);
   }

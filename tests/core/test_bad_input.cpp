@@ -88,6 +88,16 @@ TEST_CASE("URDF errors name the file and the element", "[input][urdf]") {
                                      "cycle.urdf"),
                       Contains("cycle.urdf: links not connected to the root link 'a' (their joints form a loop): b, c"));
   }
+  SECTION("a file that is not UTF-8 is refused at its line, before a name with a stray byte reaches JSON (found by fuzzing)") {
+    CHECK_THROWS_WITH(loadUrdfString("<?xml version=\"1.0\"?>\n<robot name=\"t\xBB\">" + urdfLink("a") + "</robot>", "latin.urdf"),
+                      Contains("latin.urdf:2: not valid UTF-8 (byte 0xBB)"));
+    // Overlong forms and surrogates are not UTF-8 either; multi-byte names are.
+    CHECK_THROWS_WITH(loadUrdfString(robot(urdfLink("\xC0\xAF")), "overlong.urdf"), Contains("overlong.urdf:1: not valid UTF-8"));
+    CHECK_THROWS_WITH(loadUrdfString(robot(urdfLink("\xED\xA0\x80")), "surrogate.urdf"), Contains("not valid UTF-8 (byte 0xA0)"));
+    CHECK_THROWS_WITH(loadUrdfString(robot(urdfLink("\xE2\x82")), "cut.urdf"), Contains("not valid UTF-8"));
+    CHECK(loadUrdfString(robot(urdfLink("h\xC3\xBC" "fte") + urdfLink("\xF0\x9F\xA6\xBE") + joint("j", "h\xC3\xBC" "fte", "\xF0\x9F\xA6\xBE")),
+                         "utf8.urdf").bodies.size() == 2);
+  }
   SECTION("unknown body") {
     const RobotModel model = loadUrdfString(kGood, "good.urdf");
     CHECK_THROWS_WITH(DynamicsModel(model, "no_such_link"), Contains("good.urdf") && Contains("unknown body 'no_such_link'"));
@@ -160,6 +170,17 @@ TEST_CASE("actuator, contact and posture files: errors name file, line and field
   SECTION("a folder where a file is named (found by fuzzing)") {
     CHECK_THROWS_WITH(loadContactSurfaces(dir.path(), model), Contains(dir.path().string() + ": not a file"));
     CHECK_THROWS_WITH(loadUrdfFile(dir.path()), Contains(dir.path().string() + ": not a file"));
+  }
+  SECTION("a file that is not UTF-8 is refused at its line; UTF-16 is transcoded (found by fuzzing)") {
+    const auto latin = dir.write("l.yaml", "contact_surfaces:\n  pa\xBBlm: {link: hand, rectangle: [-0.1, 0.1, -0.05, 0.05]}\n");
+    CHECK_THROWS_WITH(loadContactSurfaces(latin, model), Contains("l.yaml:2: not valid UTF-8 (byte 0xBB)"));
+    const std::string text = "contact_surfaces:\n  palm: {link: hand, rectangle: [-0.1, 0.1, -0.05, 0.05]}\n";
+    std::string utf16 = "\xFF\xFE";  // little-endian byte-order mark
+    for (const char c : text) utf16 += std::string{c, '\0'};
+    const auto wide = dir.write("w.yaml", utf16);
+    const auto surfaces = loadContactSurfaces(wide, model);
+    REQUIRE(surfaces.size() == 1);
+    CHECK(surfaces[0].name == "palm");
   }
   SECTION("malformed YAML") {
     const auto file = dir.write("bad.yaml", "joints: [unclosed\n");
