@@ -1,10 +1,7 @@
 #include "sensitivity/inner_sensitivity.hpp"
 
-#include <Eigen/KLUSupport>
 #include <Eigen/LU>
 #include <Eigen/Eigenvalues>
-#include <Eigen/SparseCore>
-#include <Eigen/UmfPackSupport>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -12,6 +9,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "sensitivity/sparse_kkt_factor.hpp"
 
 namespace mcopt {
 
@@ -174,11 +172,8 @@ struct InnerSensitivity::Impl {
   // of that size is near-singular (the COD's solve allocated its temporaries every call).
   std::vector<std::unique_ptr<SymmetricEigen>> eigenBySize;
   Eigen::MatrixXd projected;  ///< Vᵀ b, then Λ⁺ Vᵀ b (capacity × columns)
-  Eigen::MatrixXd sparseRhs, sparseSolution;  ///< contiguous, of the used size: what SuiteSparse reads and writes
   bool useRankRevealing = false;
-  Eigen::SparseMatrix<double> sparse;
-  Eigen::KLU<Eigen::SparseMatrix<double>> klu;
-  Eigen::UmfPackLU<Eigen::SparseMatrix<double>> umfpack;
+  std::unique_ptr<SparseKktFactor> sparseFactor;  ///< the klu and umfpack backends
   KktBackend backendInUse = KktBackend::Dense;
   Eigen::MatrixXd weightedWrenchToTorque;  ///< diag(w) J1 of the factorised problem, for dataSensitivities
   Eigen::MatrixXd lagrangianHessian, rhs, solution;
@@ -199,6 +194,9 @@ struct InnerSensitivity::Impl {
 
 InnerSensitivity::InnerSensitivity(SensitivitySettings settings) : impl_(std::make_unique<Impl>()) {
   impl_->settings = settings;
+  if (settings.backend != KktBackend::Dense)
+    impl_->sparseFactor = std::make_unique<SparseKktFactor>(
+        settings.backend == KktBackend::SparseKlu ? SparseKktFactor::Library::Klu : SparseKktFactor::Library::Umfpack);
 }
 InnerSensitivity::~InnerSensitivity() = default;
 InnerSensitivity::InnerSensitivity(InnerSensitivity&&) noexcept = default;
@@ -305,7 +303,7 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     m.luBySize.clear();
     for (int k = m.smallest; k <= size; ++k) {
       m.systemBySize.emplace_back(k, k);
-      m.luBySize.emplace_back(k);
+      if (!m.sparseFactor) m.luBySize.emplace_back(k);  // the dense backend's LU per size
     }
     m.estimateX.resize(size), m.estimateSign.resize(size), m.estimateZ.resize(size);
     m.eigenBySize.clear();
@@ -316,29 +314,28 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   Eigen::MatrixXd& system = m.systemBySize[static_cast<std::size_t>(next - m.smallest)];
   system = m.kkt.topLeftCorner(next, next);
 
-  // Dense LU always gives the condition estimate; a near-singular system (dependent active
-  // rows, whose multipliers are then not unique while dF is) is solved in the least-norm sense.
-  Eigen::PartialPivLU<Eigen::MatrixXd>& lu = m.luBySize[static_cast<std::size_t>(next - m.smallest)];
-  lu.compute(system);
-  m.diagnostics.reciprocalCondition = reciprocalConditionEstimate(system, lu, m.estimateX, m.estimateSign, m.estimateZ);
+  // The backend's own factorisation gives the condition estimate; a near-singular system
+  // (dependent active rows, whose multipliers are then not unique while dF is) is solved in
+  // the least-norm sense (formulation.md §8), whatever the backend.
+  m.backendInUse = m.settings.backend;
+  if (m.sparseFactor) {
+    const bool factorised = m.sparseFactor->factorize(system, n + 6);
+    m.diagnostics.reciprocalCondition = factorised ? m.sparseFactor->reciprocalCondition() : 0.0;
+    m.diagnostics.analysisReused = m.sparseFactor->reusedAnalysis();
+  } else {
+    Eigen::PartialPivLU<Eigen::MatrixXd>& lu = m.luBySize[static_cast<std::size_t>(next - m.smallest)];
+    lu.compute(system);
+    m.diagnostics.reciprocalCondition = reciprocalConditionEstimate(system, lu, m.estimateX, m.estimateSign, m.estimateZ);
+  }
   if (!std::isfinite(m.diagnostics.reciprocalCondition)) m.diagnostics.reciprocalCondition = 0.0;
   m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
   if (m.useRankRevealing) {
+    m.backendInUse = KktBackend::Dense;
     auto& eigen = m.eigenBySize[static_cast<std::size_t>(next - m.smallest)];
     if (!eigen) eigen = std::make_unique<SymmetricEigen>(next);
     if (!eigen->compute(system)) m.diagnostics.reciprocalCondition = 0.0;
   }
-  m.backendInUse = KktBackend::Dense;
-  if (m.settings.backend != KktBackend::Dense && !m.useRankRevealing) {
-    m.sparse = system.sparseView();
-    if (m.settings.backend == KktBackend::SparseKlu) {
-      m.klu.compute(m.sparse);
-      if (m.klu.info() == Eigen::Success) m.backendInUse = KktBackend::SparseKlu;
-    } else {
-      m.umfpack.compute(m.sparse);
-      if (m.umfpack.info() == Eigen::Success) m.backendInUse = KktBackend::SparseUmfpack;
-    }
-  }
+  m.diagnostics.backend = m.backendInUse;
   return m.diagnostics;
 }
 
@@ -373,25 +370,13 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
   rhs.setZero();
   rhs.topRows(n) = -dStationarity;
   rhs.middleRows(n, 6) = -dBalance;
-  switch (m.backendInUse) {
-    // SuiteSparse takes contiguous matrices (leading dimension = rows), and allocates
-    // its own workspace on every factorisation anyway: plain matrices of the used size.
-    case KktBackend::SparseKlu:
-      m.sparseRhs = rhs;
-      m.sparseSolution = m.klu.solve(m.sparseRhs);
-      solution = m.sparseSolution;
-      break;
-    case KktBackend::SparseUmfpack:
-      m.sparseRhs = rhs;
-      m.sparseSolution = m.umfpack.solve(m.sparseRhs);
-      solution = m.sparseSolution;
-      break;
-    case KktBackend::Dense:
-      if (m.useRankRevealing)
-        leastNormSolve(*m.eigenBySize[static_cast<std::size_t>(size - m.smallest)], rhs, m.projected, solution);
-      else
-        solution.noalias() = m.factor().solve(rhs);
-      break;
+  if (m.useRankRevealing) {
+    leastNormSolve(*m.eigenBySize[static_cast<std::size_t>(size - m.smallest)], rhs, m.projected, solution);
+  } else if (m.backendInUse == KktBackend::Dense) {
+    solution.noalias() = m.factor().solve(rhs);
+  } else {
+    solution = rhs;
+    m.sparseFactor->solveInPlace(solution);
   }
   dWrenches = solution.topRows(n);
   if (dBalanceMultipliers != nullptr) *dBalanceMultipliers = solution.middleRows(n, 6);

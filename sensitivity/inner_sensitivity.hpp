@@ -29,8 +29,8 @@ namespace mcopt {
 
 enum class KktBackend {
   Dense,       ///< Eigen partial-pivoting LU of the per-sample KKT matrix
-  SparseKlu,   ///< SuiteSparse KLU (through Eigen's KLUSupport)
-  SparseUmfpack,  ///< SuiteSparse UMFPACK (through Eigen's UmfPackSupport)
+  SparseKlu,   ///< SuiteSparse KLU, analysis kept per pattern (sparse_kkt_factor.hpp)
+  SparseUmfpack,  ///< SuiteSparse UMFPACK, analysis kept per pattern (sparse_kkt_factor.hpp)
 };
 const char* toString(KktBackend backend);
 /// "dense", "klu" or "umfpack"; throws InputError otherwise.
@@ -57,8 +57,13 @@ struct SensitivityDiagnostics {
   int activeCones = 0;       ///< cones active on their surface
   int unloadedContacts = 0;  ///< contacts held at zero wrench
   int weaklyActive = 0;      ///< active constraints with (near) zero multiplier, left out
-  double reciprocalCondition = 1.0;  ///< of the KKT matrix (dense: LU estimate; sparse: 1/‖K‖‖K⁻¹‖ estimate unavailable, 1)
+  /// Of the KKT matrix, estimated by the backend's own factorisation: dense, Hager–Higham on
+  /// the LU; klu, klu_condest (the same estimator); umfpack, its rough min|U_ii| / max|U_ii|.
+  double reciprocalCondition = 1.0;
   int size = 0;              ///< KKT dimension
+  /// The backend that solved: the chosen one, or dense least-norm for a near-singular system.
+  KktBackend backend = KktBackend::Dense;
+  bool analysisReused = false;  ///< sparse backends: the pattern's symbolic analysis was reused
   bool degenerate() const { return weaklyActive > 0 || reciprocalCondition < 1e-13; }
   std::string describe() const;
 };

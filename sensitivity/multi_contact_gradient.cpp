@@ -2,11 +2,10 @@
 
 #include <omp.h>
 
-#include <Eigen/KLUSupport>
 #include <Eigen/SparseCore>
-#include <Eigen/UmfPackSupport>
 
 #include "core/errors.hpp"
+#include "sensitivity/sparse_kkt_factor.hpp"
 
 namespace mcopt {
 
@@ -103,16 +102,16 @@ void MultiContactGradientEvaluator::solveAllSamples() {
     if (offset[static_cast<std::size_t>(s)] >= 0)
       stacked.middleRows(offset[static_cast<std::size_t>(s)], rhs[static_cast<std::size_t>(s)].rows()) =
           rhs[static_cast<std::size_t>(s)];
-  Eigen::MatrixXd solution;
-  if (sensitivitySettings_.backend == KktBackend::SparseUmfpack) {
-    Eigen::UmfPackLU<Eigen::SparseMatrix<double>> lu(blocks);
-    if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (UMFPACK) failed");
-    solution = lu.solve(stacked);
-  } else {
-    Eigen::KLU<Eigen::SparseMatrix<double>> lu(blocks);
-    if (lu.info() != Eigen::Success) throw InputError("all-samples KKT factorisation (KLU) failed");
-    solution = lu.solve(stacked);
-  }
+  // Kept from call to call: the analysis of the whole pattern is reused while no sample's
+  // active set or contact state changes.
+  if (!allSamplesFactor_)
+    allSamplesFactor_ = std::make_unique<SparseKktFactor>(sensitivitySettings_.backend == KktBackend::SparseUmfpack
+                                                              ? SparseKktFactor::Library::Umfpack
+                                                              : SparseKktFactor::Library::Klu);
+  if (!allSamplesFactor_->factorize(blocks))
+    throw InputError(std::string("all-samples KKT factorisation (") + toString(sensitivitySettings_.backend) + ") failed");
+  Eigen::MatrixXd& solution = stacked;
+  allSamplesFactor_->solveInPlace(solution);
   const int nc = static_cast<int>(contacts_.size());
   for (int s = 0; s < count; ++s)
     if (offset[static_cast<std::size_t>(s)] >= 0)

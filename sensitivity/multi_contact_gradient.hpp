@@ -28,6 +28,8 @@
 
 namespace mcopt {
 
+class SparseKktFactor;
+
 struct SampleWrenchJacobian {
   Eigen::VectorXi parameters;  ///< global parameter index of each column
   Eigen::MatrixXd dFdx;        ///< 6nc × (jointCount · k)
@@ -71,6 +73,7 @@ class MultiContactGradientEvaluator {
   Eigen::MatrixXd controlPoints_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
   std::vector<BilevelSample> bilevel_;  ///< one per sample
+  std::unique_ptr<SparseKktFactor> allSamplesFactor_;  ///< KktLayout::AllSamples
 };
 
 }  // namespace mcopt

@@ -238,6 +238,33 @@ TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) alloca
   }
 }
 
+TEST_CASE("a multi-contact motion's exact gradient with per-sample KLU allocates nothing while the patterns hold",
+          "[sensitivity][allocation]") {
+  // KLU keeps each sample's analysis and numeric object (sparse_kkt_factor.hpp): at an
+  // iterate whose active sets are those of the last, klu_refactor, klu_condest and klu_solve
+  // work in them. (UMFPACK's numeric factorisation makes a new object every time.)
+  const HalfSitting hs;
+  SensitivitySettings klu;
+  klu.backend = KktBackend::SparseKlu;
+  for (const int contacts : {2, 3}) {
+    MultiContactGradientEvaluator evaluator(hs.model, hs.actuators, SampledTrajectory(hs.parametrization, 60),
+                                            hs.first(contacts), {}, klu);
+    Eigen::VectorXd x = hs.parametrization.constantMotion(hs.posture);
+    MultiContactResult result;
+    MultiContactGradient gradient;
+    evaluator.evaluate(x, 1.5, result, gradient);  // set-up: patterns analysed
+    x *= 1.0 + 1e-7;  // a new iterate, the same active sets
+    Measured measured;
+    evaluator.evaluate(x, 1.5, result, gradient);
+    const long during = measured.count();
+    int reused = 0;
+    for (const SensitivityDiagnostics& d : gradient.diagnostics) reused += d.analysisReused;
+    INFO(contacts << " contacts: " << reused << " of 60 samples reused their analysis");
+    REQUIRE(reused == 60);
+    CHECK(during == 0);
+  }
+}
+
 TEST_CASE("the sensitivity of degenerate samples allocates nothing once warm: weakly active rows, near-singular systems",
           "[sensitivity][allocation]") {
   // formulation.md §8: a weakly active row is left out (one-sided derivatives); a

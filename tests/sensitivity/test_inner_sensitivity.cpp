@@ -141,7 +141,7 @@ TEST_CASE("dense, KLU and UMFPACK factorisations give the same sensitivities", "
       SensitivitySettings settings;
       settings.backend = backend;
       InnerSensitivity sensitivity(settings);
-      sensitivity.factorize(p, solution);
+      CHECK_FALSE(sensitivity.factorize(p, solution).analysisReused);
       Eigen::MatrixXd dTau0, dBalance;
       sensitivity.dataSensitivities(p, dTau0, dBalance);
       if (backend == KktBackend::Dense) {
@@ -149,6 +149,12 @@ TEST_CASE("dense, KLU and UMFPACK factorisations give the same sensitivities", "
         continue;
       }
       INFO(toString(backend));
+      CHECK(sensitivity.diagnostics().backend == backend);
+      // The same pattern again: analysis kept, numeric factorisation only, the same answer.
+      CHECK(sensitivity.factorize(p, solution).analysisReused);
+      Eigen::MatrixXd again, againBalance;
+      sensitivity.dataSensitivities(p, again, againBalance);
+      CHECK((again - dTau0).cwiseAbs().maxCoeff() <= 1e-12 * (1.0 + dTau0.cwiseAbs().maxCoeff()));
       CHECK((dTau0 - reference).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + reference.cwiseAbs().maxCoeff()));
       CHECK((dBalance - referenceBalance).cwiseAbs().maxCoeff() <= 1e-9 * (1.0 + referenceBalance.cwiseAbs().maxCoeff()));
     }
@@ -313,6 +319,16 @@ TEST_CASE("the KKT condition estimate bounds the exact one, and a near-singular 
       // within the factor Hager's method is known for (10 here; 3 is typical).
       CHECK(estimate >= exact * (1.0 - 1e-9));
       CHECK(estimate <= 10.0 * exact);
+      // KLU's own estimate (klu_condest, the same estimator on its factors) bounds it alike;
+      // UMFPACK's is only a pivot ratio, a number in (0, 1].
+      SensitivitySettings klu, umfpack;
+      klu.backend = KktBackend::SparseKlu, umfpack.backend = KktBackend::SparseUmfpack;
+      const double kluEstimate = InnerSensitivity(klu).factorize(p, solution).reciprocalCondition;
+      CHECK(kluEstimate >= exact * (1.0 - 1e-9));
+      CHECK(kluEstimate <= 10.0 * exact);
+      const double umfpackEstimate = InnerSensitivity(umfpack).factorize(p, solution).reciprocalCondition;
+      CHECK(umfpackEstimate > 0.0);
+      CHECK(umfpackEstimate <= 1.0);
       ++bounded;
     }
     // Without its Tikhonov term H leaves the balance's null space uncurved (6 joints for up
