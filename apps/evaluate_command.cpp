@@ -87,7 +87,7 @@ MotionFile readMotionFile(const std::filesystem::path& path) {
 Eigen::VectorXd readPosture(const std::filesystem::path& path, const YAML::Node& node, const std::string& field,
                             const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
   yaml::rejectUnknownKeys(path, node, field, {"posture", "offsets"});
-  return postureWithOffsets(path, node, field, robot, postures);
+  return yaml::postureWithOffsets(path, node, field, robot, postures);
 }
 
 std::string trajectoryCsv(const RobotModel& robot, const TrajectoryResult& r) {

@@ -1,5 +1,7 @@
 #include "core/dynamics_derivatives.hpp"
 
+#include "core/hot_path_checks.hpp"
+
 namespace mcopt {
 
 DynamicsDerivatives::DynamicsDerivatives(const DynamicsModel& model) {
@@ -49,6 +51,8 @@ MCOPT_ALWAYS_INLINE Vector6 momentumCouplingTimes(const Terms& t, const Vector6&
 
 void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, DynamicsDerivatives& d,
                                 const ConstVectorRef& q, const ConstVectorRef& v, const ConstVectorRef& a) {
+  MCOPT_HOT_PATH_CHECK(d.dtauDq.rows() == model.jointCount() && d.dtauDq.cols() == model.jointCount(),
+                       "inverseDynamicsDerivatives: derivatives were made for another model");
   inverseDynamics(model, data, q, v, a);
   const auto& edges = model.treeJoints();
   const auto& inertias = model.inertias();

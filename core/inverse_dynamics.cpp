@@ -1,5 +1,7 @@
 #include "core/inverse_dynamics.hpp"
 
+#include "core/hot_path_checks.hpp"
+
 namespace mcopt {
 
 DynamicsData::DynamicsData(const DynamicsModel& model) {
@@ -70,6 +72,9 @@ inline void placeRoot(const DynamicsModel& model, DynamicsData& d) {
 }  // namespace
 
 void forwardKinematics(const DynamicsModel& model, DynamicsData& data, const ConstVectorRef& q) {
+  MCOPT_HOT_PATH_CHECK(q.size() == model.jointCount(), "forwardKinematics: q must have jointCount() entries");
+  MCOPT_HOT_PATH_CHECK(static_cast<int>(data.rotation.size()) == model.bodyCount(),
+                       "forwardKinematics: data was made for another model");
   placeRoot(model, data);
   const auto& edges = model.treeJoints();
   const auto& inertias = model.inertias();
@@ -82,6 +87,10 @@ void forwardKinematics(const DynamicsModel& model, DynamicsData& data, const Con
 
 void inverseDynamics(const DynamicsModel& model, DynamicsData& d, const ConstVectorRef& q, const ConstVectorRef& v,
                      const ConstVectorRef& a) {
+  MCOPT_HOT_PATH_CHECK(q.size() == model.jointCount() && v.size() == model.jointCount() && a.size() == model.jointCount(),
+                       "inverseDynamics: q, v and a must have jointCount() entries");
+  MCOPT_HOT_PATH_CHECK(static_cast<int>(d.rotation.size()) == model.bodyCount() && d.tau.size() == model.jointCount(),
+                       "inverseDynamics: data was made for another model");
   const auto& edges = model.treeJoints();
   const auto& inertias = model.inertias();
   const int nb = model.bodyCount();

@@ -1,8 +1,11 @@
 #include "core/kinematics.hpp"
 
+#include "core/hot_path_checks.hpp"
+
 namespace mcopt {
 
 RigidTransform framePose(const DynamicsModel& model, const DynamicsData& data, int frame) {
+  MCOPT_HOT_PATH_CHECK(frame >= 0 && frame < static_cast<int>(model.robot().frames.size()), "framePose: no such frame");
   const int position = model.framePosition(frame);
   const RigidTransform body{data.rotation[position], data.position[position]};
   return body * model.framePlacement(frame);
@@ -20,6 +23,7 @@ Vector3 centerOfMass(const DynamicsModel& model, const DynamicsData& data) {
 
 void frameJacobian(const DynamicsModel& model, const DynamicsData& data, int bodyPosition, const Vector3& point,
                    FrameJacobian& jacobian) {
+  MCOPT_HOT_PATH_CHECK(bodyPosition >= 0 && bodyPosition < model.bodyCount(), "frameJacobian: no such body");
   jacobian.setZero(6, model.jointCount());
   const auto& edges = model.treeJoints();
   for (int i = bodyPosition; i > 0; i = edges[i].parent) {

@@ -10,20 +10,29 @@
 
 namespace mcopt {
 
+#ifdef MCOPT_CHECK_MALLOC
+/// Called by every scope as it arms, with the name of its path, on the thread that armed it:
+/// tests record which per-sample paths are guarded and allocate under a guard on purpose
+/// (tests/core/test_no_malloc_scope.cpp). Null otherwise; debug builds only.
+inline void (*noMallocProbe)(const char* path) = nullptr;
+#endif
+
 class NoMallocScope {
  public:
 #ifdef MCOPT_CHECK_MALLOC
-  /// `armed` false: the path is not warm yet (its buffers are sized inside), nothing is checked.
-  explicit NoMallocScope(bool armed = true) : armed_(armed) {
+  /// `path` names the per-sample path guarded (a literal). `armed` false: the path is not warm
+  /// yet (its buffers are sized inside), nothing is checked.
+  explicit NoMallocScope(const char* path, bool armed = true) : armed_(armed) {
     if (!armed_) return;
     previous_ = Eigen::internal::is_malloc_allowed();  // (set_is_malloc_allowed returns the new value)
     Eigen::internal::set_is_malloc_allowed(false);
+    if (noMallocProbe != nullptr) noMallocProbe(path);
   }
   ~NoMallocScope() {
     if (armed_) Eigen::internal::set_is_malloc_allowed(previous_);
   }
 #else
-  explicit NoMallocScope(bool = true) {}
+  explicit NoMallocScope(const char*, bool = true) {}
 #endif
   NoMallocScope(const NoMallocScope&) = delete;
   NoMallocScope& operator=(const NoMallocScope&) = delete;

@@ -83,8 +83,9 @@ std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path&
   return yaml::reading(path, [&] { return readPostures(path, robot); });
 }
 
-Eigen::VectorXd postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
-                                   const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
+Eigen::VectorXd yaml::postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node,
+                                         const std::string& field, const RobotModel& robot,
+                                         const std::map<std::string, Eigen::VectorXd>& postures) {
   const YAML::Node nameNode = yaml::required(file, node, "posture", field);
   const std::string name = yaml::text(file, nameNode, field + ".posture");
   const auto found = postures.find(name);

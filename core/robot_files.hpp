@@ -10,10 +10,6 @@
 
 #include "core/robot_model.hpp"
 
-namespace YAML {
-class Node;
-}
-
 namespace mcopt {
 
 /// A rectangular contact surface on a body: frame C (z = surface normal pointing into
@@ -31,11 +27,5 @@ std::vector<ContactSurface> loadContactSurfaces(const std::filesystem::path& pat
 
 /// Named postures: joint values in URDF order, joints not listed at zero.
 std::map<std::string, Eigen::VectorXd> loadPostures(const std::filesystem::path& path, const RobotModel& robot);
-
-/// A posture named in a motion or scenario file: `posture: NAME` and optional
-/// `offsets: {joint: rad}` added to it. `file` and `field` locate `node` for errors
-/// (unknown posture or joint); the caller checks which other keys `node` may hold.
-Eigen::VectorXd postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
-                                   const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures);
 
 }  // namespace mcopt

@@ -50,7 +50,7 @@ void TrajectoryEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& para
   prepareTrajectoryResult(samples_, n, parameters, duration, r);
   samples_.parametrization().controlPoints(parameters, controlPoints_);
 
-  const NoMallocScope perSample;  // `r` is sized above; the samples allocate nothing
+  const NoMallocScope perSample("trajectory evaluation");  // `r` is sized above; the samples allocate nothing
 #pragma omp parallel for schedule(static)
   for (int s = 0; s < count; ++s) {
     DynamicsData& data = threadData_[static_cast<std::size_t>(omp_get_thread_num())];

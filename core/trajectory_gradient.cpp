@@ -38,7 +38,7 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
   // Each sample's Jacobian block is sized by its first evaluation: checked once they all are.
   bool sized = true;
   for (const SampleTorqueJacobian& block : g.torque) sized = sized && block.dtauDx.size() > 0;
-  const NoMallocScope perSample(sized);
+  const NoMallocScope perSample("trajectory gradient", sized);
 #pragma omp parallel for schedule(static)
   for (int s = 0; s < count; ++s) {
     ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];

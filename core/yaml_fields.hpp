@@ -1,6 +1,7 @@
 #pragma once
 // Reading YAML with messages that name the file, the line and the field (yaml-cpp marks).
-// Private to the loaders' .cpp files.
+// For the loaders' .cpp files: the one core header with yaml-cpp types, which core links
+// privately — a target including it links yaml-cpp itself (tests/header_boundaries.cmake).
 
 #include <yaml-cpp/yaml.h>
 
@@ -9,12 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/robot_model.hpp"
 #include "core/text_encoding.hpp"
 
 namespace mcopt::yaml {
@@ -81,6 +84,13 @@ inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Nod
                        list + ")");
   }
 }
+
+/// A posture named in a motion or scenario file: `posture: NAME` and optional
+/// `offsets: {joint: rad}` added to it. `file` and `field` locate `node` for errors
+/// (unknown posture or joint); the caller checks which other keys `node` may hold.
+/// (core/robot_files.cpp)
+Eigen::VectorXd postureWithOffsets(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
+                                   const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures);
 
 inline double number(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
   double value = 0.0;

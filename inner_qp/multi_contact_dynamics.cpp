@@ -159,7 +159,7 @@ void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& pa
   const int threads = static_cast<int>(workspaces_.size());
   // The inner solvers size their buffers on their first problem: checked from the second
   // evaluation on (the contact set is fixed, so the shapes are).
-  const NoMallocScope perSample(sized_ && capture_ == nullptr);  // copying problems out allocates
+  const NoMallocScope perSample("inner solves", sized_ && capture_ == nullptr);  // copying problems out allocates
 #pragma omp parallel num_threads(threads)
   {
     // One contiguous block of samples per thread: the warm start follows the motion.

@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
+#include "core/no_malloc_scope.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
@@ -562,21 +563,27 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   // predecessor in the chunk. The chunks, not the thread count, decide every warm start, so
   // the results are the same, to the bit, for any thread count (docs/scenarios.md, "Determinism").
   const int chunks = (count + kWarmStartChunk - 1) / kWarmStartChunk;
-#pragma omp parallel num_threads(threads)
   {
-    ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    // After the first evaluation of its kind every buffer is sized: no Eigen allocation here
+    // (debug builds check; tests/core/test_no_allocation.cpp counts every allocation).
+    const NoMallocScope perSample("outer evaluation", derivatives ? sizedWithDerivatives_ : sizedValues_);
+#pragma omp parallel num_threads(threads)
+    {
+      ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
-    for (int chunk = 0; chunk < chunks; ++chunk) {
-      const int first = chunk * kWarmStartChunk, last = std::min(count, first + kWarmStartChunk);
-      for (int s = first; s < last; ++s) {
-        if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
-          bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
-        evaluateSample(s, x, T, derivatives, w);
+      for (int chunk = 0; chunk < chunks; ++chunk) {
+        const int first = chunk * kWarmStartChunk, last = std::min(count, first + kWarmStartChunk);
+        for (int s = first; s < last; ++s) {
+          if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
+            bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
+          evaluateSample(s, x, T, derivatives, w);
+        }
       }
-    }
 #pragma omp for schedule(static)
-    for (int i = 0; i < taskCount; ++i) evaluateTaskInstant(i, T, derivatives, w);
+      for (int i = 0; i < taskCount; ++i) evaluateTaskInstant(i, T, derivatives, w);
+    }
   }
+  (derivatives ? sizedWithDerivatives_ : sizedValues_) = true;
   cachedX_ = x;
   cachedDerivatives_ = derivatives;
   cacheValid_ = true;

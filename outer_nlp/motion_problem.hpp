@@ -275,6 +275,7 @@ class MotionProblem final : public NlpProblem {
   Eigen::MatrixXd controlPoints_;
   Eigen::VectorXd cachedX_;
   bool cachedDerivatives_ = false, cacheValid_ = false;
+  bool sizedValues_ = false, sizedWithDerivatives_ = false;  ///< an evaluation of that kind has run (NoMallocScope)
 };
 
 }  // namespace mcopt

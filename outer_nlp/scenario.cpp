@@ -1,4 +1,4 @@
-#include "outer_nlp/scenario.hpp"
+#include "outer_nlp/scenario_yaml.hpp"
 
 #include <cmath>
 #include <algorithm>
@@ -45,7 +45,7 @@ std::filesystem::path sideFile(const std::filesystem::path& file, const YAML::No
 Eigen::VectorXd readPosture(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
                             const RobotModel& robot, const std::map<std::string, Eigen::VectorXd>& postures) {
   yaml::rejectUnknownKeys(file, node, field, {"posture", "offsets", "fixed"});
-  return postureWithOffsets(file, node, field, robot, postures);
+  return yaml::postureWithOffsets(file, node, field, robot, postures);
 }
 
 /// Three bounds, each a number or null (free).

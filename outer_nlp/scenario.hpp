@@ -17,10 +17,6 @@
 #include "inner_qp/multi_contact_dynamics.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
 
-namespace YAML {
-class Node;
-}
-
 namespace mcopt {
 
 enum class EnergyForm {
@@ -165,9 +161,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k);
 /// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints
 /// or postures, and impossible numbers.
 Scenario loadScenario(const std::filesystem::path& file);
-/// The same for a scenario already parsed (a study's case, docs/studies.md): `file` names it
-/// in messages, and its folder is where relative side-file paths start.
-Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file);
+/// (A scenario already parsed as YAML: outer_nlp/scenario_yaml.hpp.)
 
 /// The fields that name side files, relative to the scenario's folder: a copy of the scenario
 /// written elsewhere must make them absolute.

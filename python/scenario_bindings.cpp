@@ -14,6 +14,7 @@
 #include "core/yaml_fields.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/scenario.hpp"
+#include "outer_nlp/scenario_yaml.hpp"
 #include "outer_nlp/scenario_run.hpp"
 #include "python/bindings.hpp"
 #include "python/robot_handle.hpp"

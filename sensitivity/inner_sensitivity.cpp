@@ -168,9 +168,14 @@ struct InnerSensitivity::Impl {
   // Near-singular systems (formulation.md §8: dependent active rows, or a null space no row
   // or curvature fixes) are solved in the least-norm sense through the symmetric KKT
   // matrix's eigendecomposition, K⁺ = V Λ⁺ Vᵀ — the minimum-norm solution a complete
-  // orthogonal decomposition gives, but computed in workspace made the first time a system
-  // of that size is near-singular (the COD's solve allocated its temporaries every call).
-  std::vector<std::unique_ptr<SymmetricEigen>> eigenBySize;
+  // orthogonal decomposition gives, in workspace of the largest size made with the problem's
+  // shape (the COD's solve allocated its temporaries every call). A system of a smaller size
+  // k is decomposed as diag(K, s I) with s = max|K_ij| ≤ ‖K‖₂: its pseudo-inverse is
+  // diag(K⁺, I/s), the rank threshold (set by max|λ|) is K's own, and nothing is made later —
+  // where the debug build's no-malloc check is armed (core/no_malloc_scope.hpp) — at the
+  // price of a capacity-sized decomposition for the rare near-singular sample.
+  std::unique_ptr<SymmetricEigen> eigen;
+  Eigen::MatrixXd padded;     ///< diag(K, s I), capacity × capacity
   Eigen::MatrixXd projected;  ///< Vᵀ b, then Λ⁺ Vᵀ b (capacity × columns)
   bool useRankRevealing = false;
   std::unique_ptr<SparseKktFactor> sparseFactor;  ///< the klu and umfpack backends
@@ -306,8 +311,8 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       if (!m.sparseFactor) m.luBySize.emplace_back(k);  // the dense backend's LU per size
     }
     m.estimateX.resize(size), m.estimateSign.resize(size), m.estimateZ.resize(size);
-    m.eigenBySize.clear();
-    m.eigenBySize.resize(static_cast<std::size_t>(size - m.smallest + 1));
+    m.eigen = std::make_unique<SymmetricEigen>(size);
+    m.padded.resize(size, size);
   }
   m.used = next;
   m.diagnostics.size = next;
@@ -331,9 +336,12 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
   if (m.useRankRevealing) {
     m.backendInUse = KktBackend::Dense;
-    auto& eigen = m.eigenBySize[static_cast<std::size_t>(next - m.smallest)];
-    if (!eigen) eigen = std::make_unique<SymmetricEigen>(next);
-    if (!eigen->compute(system)) m.diagnostics.reciprocalCondition = 0.0;
+    double padding = system.cwiseAbs().maxCoeff();
+    if (padding == 0.0) padding = 1.0;
+    m.padded.setZero();
+    m.padded.topLeftCorner(next, next) = system;
+    m.padded.diagonal().tail(m.capacity - next).setConstant(padding);
+    if (!m.eigen->compute(m.padded)) m.diagnostics.reciprocalCondition = 0.0;
   }
   m.diagnostics.backend = m.backendInUse;
   return m.diagnostics;
@@ -365,13 +373,15 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
   const Eigen::Index columns = dStationarity.cols();
   if (m.rhs.rows() != m.capacity || m.rhs.cols() != columns) m.rhs.resize(m.capacity, columns);
   if (m.solution.rows() != m.capacity || m.solution.cols() != columns) m.solution.resize(m.capacity, columns);
+  if (m.projected.rows() != m.capacity || m.projected.cols() != columns) m.projected.resize(m.capacity, columns);
   auto rhs = m.rhs.topRows(size);
   auto solution = m.solution.topRows(size);
   rhs.setZero();
   rhs.topRows(n) = -dStationarity;
   rhs.middleRows(n, 6) = -dBalance;
   if (m.useRankRevealing) {
-    leastNormSolve(*m.eigenBySize[static_cast<std::size_t>(size - m.smallest)], rhs, m.projected, solution);
+    m.rhs.bottomRows(m.capacity - size).setZero();  // the padding's rows: its part of the solution is 0
+    leastNormSolve(*m.eigen, m.rhs, m.projected, m.solution);
   } else if (m.backendInUse == KktBackend::Dense) {
     solution.noalias() = m.factor().solve(rhs);
   } else {

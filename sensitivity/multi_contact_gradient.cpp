@@ -3,8 +3,10 @@
 #include <omp.h>
 
 #include <Eigen/SparseCore>
+#include <optional>
 
 #include "core/errors.hpp"
+#include "core/no_malloc_scope.hpp"
 #include "sensitivity/sparse_kkt_factor.hpp"
 
 namespace mcopt {
@@ -191,6 +193,18 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
     w->degenerate = w->withoutDerivative = 0;
   }
   const int threads = static_cast<int>(workspaces_.size());
+  // Once every sample's buffers are sized by a first evaluation, the per-sample path —
+  // dynamics, inner solve, KKT assembly, factorisation and solve, chain rule — makes no Eigen
+  // allocation (debug builds check; the all-samples layout's assembly allocates).
+  // (The caller's output blocks too: a new MultiContactGradient is sized by its first use.)
+  bool outputSized = true;
+  for (int s = 0; s < count; ++s)
+    outputSized = outputSized && grad.torqueAndEnergy.torque[static_cast<std::size_t>(s)].dtauDx.size() > 0 &&
+                  grad.wrenches[static_cast<std::size_t>(s)].dFdx.size() > 0;
+  const bool armed = sized_ && outputSized;
+  const bool perSampleLayout = sensitivitySettings_.layout == KktLayout::PerSample;
+  std::optional<NoMallocScope> perSample;
+  perSample.emplace("sensitivity", armed && perSampleLayout);
 #pragma omp parallel num_threads(threads)
   {
     // One contiguous block of samples per thread: a sample without a result of its own (the
@@ -204,7 +218,11 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
       prepareSample(w, s, duration, r, grad);
     }
   }
-  if (sensitivitySettings_.layout == KktLayout::AllSamples) solveAllSamples();
+  if (!perSampleLayout) {
+    perSample.reset();
+    solveAllSamples();
+    perSample.emplace("sensitivity", armed);
+  }
 #pragma omp parallel num_threads(threads)
   {
     const int t = omp_get_thread_num(), used = omp_get_num_threads();
@@ -212,6 +230,8 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
     Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
     for (int s = first; s < last; ++s) finishSample(w, s, duration, r, grad);
   }
+  perSample.reset();
+  sized_ = true;
   r.innerTimeUs = 0.0;
   r.infeasibleSamples = r.failedSamples = 0;
   for (int s = 0; s < count; ++s) {

@@ -74,6 +74,7 @@ class MultiContactGradientEvaluator {
   std::vector<std::unique_ptr<Workspace>> workspaces_;
   std::vector<BilevelSample> bilevel_;  ///< one per sample
   std::unique_ptr<SparseKktFactor> allSamplesFactor_;  ///< KktLayout::AllSamples
+  bool sized_ = false;  ///< an evaluation has run: every sample's buffers are sized (NoMallocScope)
 };
 
 }  // namespace mcopt

@@ -10,6 +10,7 @@
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
 #include "outer_nlp/scenario.hpp"
+#include "outer_nlp/scenario_yaml.hpp"
 #include "study/scenario_tree.hpp"
 
 namespace mcopt::study {

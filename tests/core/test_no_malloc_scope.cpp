@@ -11,17 +11,17 @@ TEST_CASE("a no-malloc scope forbids Eigen allocations while it lives, nested or
   using Eigen::internal::is_malloc_allowed;
   REQUIRE(is_malloc_allowed());
   {
-    const NoMallocScope outer;
+    const NoMallocScope outer("test, outer");
     CHECK_FALSE(is_malloc_allowed());
     {
-      const NoMallocScope inner;
+      const NoMallocScope inner("test, inner");
       CHECK_FALSE(is_malloc_allowed());
     }
     CHECK_FALSE(is_malloc_allowed());  // the outer scope still holds
   }
   CHECK(is_malloc_allowed());
   {
-    const NoMallocScope unarmed(false);
+    const NoMallocScope unarmed("test, unarmed", false);
     CHECK(is_malloc_allowed());
   }
   CHECK(is_malloc_allowed());
