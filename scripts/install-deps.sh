@@ -15,6 +15,7 @@ packages=(
   libbenchmark-dev         # Google Benchmark
   python3-matplotlib       # plots (scripts/plot_*.py) and the Python example
   pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (docs/python.md) and its tests
+  python3-cvxopt           # the independent conic reference of the inner baselines (scripts/inner_baselines.py)
   slurm-wlm munge          # studies as Slurm job arrays; scripts/slurm-local.sh and its test
   libjs-three              # three.js, inlined into the pages of `mcopt replay` (docs/replay.md)
   chromium                 # headless browser of the replay's test
