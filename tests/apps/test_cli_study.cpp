@@ -31,10 +31,14 @@ constexpr bool kUnderSanitizers = false;
 
 /// Four cases of the kick at 10 samples: two stopped at 15 iterations (≈ 0.5 s), two at 100
 /// (≈ 3 s), so that a test can stop the study while only the last two run.
-std::filesystem::path fourCaseSweep(const test::TempDir& dir, const std::string& extra = "") {
+/// `longIterations`: the iteration limit of cases 2 and 3; with `neverConverged`, a tolerance
+/// no case reaches, so that each runs exactly that many iterations.
+std::filesystem::path fourCaseSweep(const test::TempDir& dir, const std::string& extra = "", int longIterations = 100,
+                                    bool neverConverged = false) {
   return dir.write("sweep.yaml", "description: four short kicks\nscenario: " + (test::sourceDir() / "scenarios/hrp2_kick.yaml").string() +
-                                     "\nset:\n  samples: 10\n  initialisation.configuration_optimisation: false\n"
-                                     "vary:\n  - {field: solver.max_iter, values: [15, 100]}\n"
+                                     "\nset:\n  samples: 10\n  initialisation.configuration_optimisation: false\n" +
+                                     (neverConverged ? "  solver.tol: 1.0e-14\n  solver.acceptable_iter: 0\n" : "") +
+                                     "vary:\n  - {field: solver.max_iter, values: [15, " + std::to_string(longIterations) + "]}\n"
                                      "  - {field: 'tasks[kick].target[0]', values: [0.8, 1.0]}\n"
                                      "resources: {threads: 1, memory: 1G}\n" + extra);
 }
@@ -212,7 +216,9 @@ TEST_CASE("study: a Slurm job array on a local cluster gives the local pool's ca
   INFO(fileText(dir.path() / "slurm-start.log"));
   REQUIRE(started == 0);
   const std::string environment = "SLURM_CONF=" + (cluster / "slurm.conf").string();
-  const auto sweep = fourCaseSweep(dir);
+  // Cases 2 and 3 run 300 iterations (about 7 s each here): scancel must land while they run,
+  // and with 100 (2 s) a loaded machine let case 2 finish first.
+  const auto sweep = fourCaseSweep(dir, "", 300, true);
 
   const auto pool = dir.path() / "pool", slurm = dir.path() / "slurm-study";
   REQUIRE(test::runMcopt("study " + test::quoted(sweep) + " --jobs 2 --out " + test::quoted(pool)).exitCode == 0);
