@@ -43,7 +43,7 @@ MotionFile readMotionFile(const std::filesystem::path& path) {
   // Paths are relative to the motion file, never to the working directory.
   auto file = [&](const char* key) {
     const auto p = dir / yaml::text(path, yaml::required(path, root, key, ""), key);
-    if (!std::filesystem::exists(p))
+    if (!pathExists(p))
       throw InputError(yaml::where(path, root[key], key) + "file not found: " + p.string());
     return p;
   };

@@ -9,13 +9,14 @@
 #include <string>
 
 #include "core/errors.hpp"
+#include "core/path_status.hpp"
 
 namespace mcopt::json_io {
 
 using Json = nlohmann::json;
 
 inline Json readFile(const std::filesystem::path& path) {
-  if (std::filesystem::exists(path) && !std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": not a file");
+  if (pathExists(path) && !isRegularFile(path)) throw InputError(path.string() + ": not a file");
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open (missing or unreadable)");
   try {

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/path_status.hpp"
 #include "core/text_encoding.hpp"
 
 namespace mcopt {
@@ -258,7 +259,7 @@ RobotModel loadUrdfString(const std::string& xml, const std::string& sourceName,
 }
 
 RobotModel loadUrdfFile(const std::filesystem::path& path, const UrdfOptions& options) {
-  if (std::filesystem::exists(path) && !std::filesystem::is_regular_file(path)) throw InputError(path.string() + ": not a file");
+  if (pathExists(path) && !isRegularFile(path)) throw InputError(path.string() + ": not a file");
   std::ifstream in(path);
   if (!in) throw InputError(path.string() + ": cannot open URDF file (missing or unreadable)");
   std::stringstream content;

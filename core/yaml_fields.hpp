@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/errors.hpp"
+#include "core/path_status.hpp"
 #include "core/robot_model.hpp"
 #include "core/text_encoding.hpp"
 
@@ -42,9 +43,9 @@ auto reading(const std::filesystem::path& file, Read&& read) {
 }
 
 inline YAML::Node loadFile(const std::filesystem::path& file) {
-  if (!std::filesystem::exists(file)) throw InputError(file.string() + ": file not found");
+  if (!pathExists(file)) throw InputError(file.string() + ": file not found");
   // A folder named as a file makes the stream throw ios_base::failure (found by fuzzing).
-  if (!std::filesystem::is_regular_file(file)) throw InputError(file.string() + ": not a file");
+  if (!isRegularFile(file)) throw InputError(file.string() + ": not a file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file.string() + ": cannot open (unreadable)");
   std::stringstream content;

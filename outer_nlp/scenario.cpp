@@ -5,6 +5,7 @@
 #include <map>
 
 #include "core/errors.hpp"
+#include "core/path_status.hpp"
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
@@ -38,7 +39,7 @@ std::filesystem::path sideFile(const std::filesystem::path& file, const YAML::No
   const YAML::Node node = yaml::required(file, root, key, "");
   // Paths are relative to the scenario file, never to the working directory.
   const auto path = file.parent_path() / yaml::text(file, node, key);
-  if (!std::filesystem::exists(path)) throw InputError(where(file, node, key) + "file not found: " + path.string());
+  if (!pathExists(path)) throw InputError(where(file, node, key) + "file not found: " + path.string());
   return path;
 }
 
