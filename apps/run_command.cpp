@@ -101,7 +101,7 @@ int runMotion(const RunOptions& o) {
     if (solve.joinedTorqueRows > 0)
       std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.torqueScreening
                 << " of their limit: solving again with them\n";
-    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(scenario.hessian);
+    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(solve.scenario.hessian);
     if (solve.stages > 1) {
       std::cout << "; stage " << solve.stage + 1 << " of " << solve.stages << ": ν = "
                 << solve.scenario.actuators.frictionSharpness << " s/rad";

@@ -186,6 +186,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
     stages.push_back({{"friction_sharpness", stage.frictionSharpness},
                       {"smoothing", stage.smoothing},
                       {"samples", stage.samples},
+                      {"hessian", toString(stage.hessian)},
                       {"status", toString(stage.status)},
                       {"iterations", stage.iterations},
                       {"seconds", stage.seconds},

@@ -74,6 +74,11 @@ double frictionTorqueSlope(const ActuatorParameters& actuator, double motorSpeed
   return actuator.viscousFriction + actuator.dryFriction * (2.0 / std::numbers::pi) * sharpness / (1.0 + x * x);
 }
 
+double frictionTorqueCurvature(const ActuatorParameters& actuator, double motorSpeed, double sharpness) {
+  const double x = sharpness * motorSpeed, denominator = 1.0 + x * x;
+  return -actuator.dryFriction * (2.0 / std::numbers::pi) * 2.0 * sharpness * sharpness * x / (denominator * denominator);
+}
+
 MotorPower motorPower(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
                       double acceleration) {
   const double n = actuator.gearRatio;
@@ -99,6 +104,22 @@ MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, 
   d.dVelocity = n * p.motorTorque + dPdMotorTorque * n * frictionSlope;
   d.dAcceleration = dPdMotorTorque * actuator.rotorInertia * n;
   return d;
+}
+
+Eigen::Matrix3d motorPowerHessian(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
+                                  double acceleration) {
+  const MotorPower p = motorPower(actuator, sharpness, torque, velocity, acceleration);
+  const double n = actuator.gearRatio, k = actuator.torqueConstant, r = actuator.resistance / (k * k);
+  const double motorSpeed = n * velocity;
+  const double dPdMotorTorque = motorSpeed + 2.0 * r * p.motorTorque;
+  const Eigen::Vector3d g(1.0 / n, n * frictionTorqueSlope(actuator, motorSpeed, sharpness), actuator.rotorInertia * n);
+  // g eΩᵀ + eΩ gᵀ + 2 (R/K²) g gᵀ entry by entry (eΩ = (0, N, 0)), so that it is symmetric to the bit.
+  Eigen::Matrix3d h = 2.0 * r * g * g.transpose();
+  for (int i = 0; i < 3; ++i) h(i, 1) += g[i] * n, h(1, i) += g[i] * n;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < i; ++j) h(j, i) = h(i, j);
+  h(1, 1) += dPdMotorTorque * n * n * frictionTorqueCurvature(actuator, motorSpeed, sharpness);
+  return h;
 }
 
 ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& robot) {

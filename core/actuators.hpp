@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/robot_model.hpp"
 
 namespace mcopt {
@@ -46,6 +48,8 @@ ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& r
 double frictionTorque(const ActuatorParameters& actuator, double motorSpeed, double sharpness);
 /// dΓ_fric/dΩ at motor speed Ω.
 double frictionTorqueSlope(const ActuatorParameters& actuator, double motorSpeed, double sharpness);
+/// d²Γ_fric/dΩ² (the dry friction's arctan alone: the viscous part is linear).
+double frictionTorqueCurvature(const ActuatorParameters& actuator, double motorSpeed, double sharpness);
 
 struct MotorPower {
   double motorTorque = 0.0;  ///< Γem [N m], motor side
@@ -65,5 +69,12 @@ struct MotorPowerDerivatives {
 
 MotorPowerDerivatives motorPowerDerivatives(const ActuatorParameters& actuator, double sharpness, double torque,
                                             double velocity, double acceleration);
+
+/// Second derivatives of P in (Γ, q̇, q̈), symmetric 3 × 3, exact (formulation.md §6 with
+/// Γem = Γ/N + I_m N q̈ + Γ_fric(N q̇), Ω = N q̇, P = Γem Ω + (R/K²) Γem²):
+///   ∇²P = g eΩᵀ + eΩ gᵀ + 2 (R/K²) g gᵀ + (∂P/∂Γem) N² Γ_fric''(Ω) e_q̇ e_q̇ᵀ,
+/// with g = ∇Γem = (1/N, N Γ_fric'(Ω), I_m N) and eΩ = ∇Ω = (0, N, 0).
+Eigen::Matrix3d motorPowerHessian(const ActuatorParameters& actuator, double sharpness, double torque, double velocity,
+                                  double acceleration);
 
 }  // namespace mcopt

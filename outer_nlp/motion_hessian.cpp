@@ -10,9 +10,10 @@
 // columns) evaluations of one sample's derivatives (central differences, 20× more accurate
 // on the kick, took 316 iterations against 361 but twice the Hessian's time: slower overall), where differencing the whole gradient
 // costs one whole-trajectory evaluation per spline parameter. Samples are independent, so
-// they run in parallel. The duration's column (when it is free) is a forward difference of
-// the whole gradient: T scales every sample's velocity and acceleration and the trapezoid
-// weights.
+// they run in parallel. `gauss-newton` assembles H_s from the sample's exact first
+// derivatives instead (sampleGaussNewtonHessian: no extra evaluation; a model, not the
+// Hessian). The duration's column (when it is free) is a forward difference of the whole
+// gradient: T scales every sample's velocity and acceleration and the trapezoid weights.
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
@@ -34,7 +35,8 @@ inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::ab
 
 void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                       const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
-  if (scenario_.hessian == HessianOption::SampleDifferences || scenario_.hessian == HessianOption::ConvexSampleDifferences)
+  if (scenario_.hessian == HessianOption::SampleDifferences || scenario_.hessian == HessianOption::ConvexSampleDifferences ||
+      scenario_.hessian == HessianOption::GaussNewton)
     sampleDifferencesHessian(x, objectiveFactor, multipliers, values);
   else
     NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
@@ -55,6 +57,59 @@ void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::
   gradient.segment(2 * n, n) += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration;
   const Eigen::Index forces = gradient.size() - 3 * n;
   if (forces > 0) gradient.tail(forces).noalias() = b.dyDz.leftCols(forces).transpose() * h.weights;
+}
+
+void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                             double objectiveWeight, HessianWorkspace& h) const {
+  // The sample's terms are functions of its outputs: c σ(P_j) (smooth maximum) or λ_P P_j
+  // (epigraph) per joint, P_j = P(Γ_j, q̇_j, q̈_j) (core/actuators.hpp), and c w q̈² for the
+  // regularisation. Their exact curvature in (Γ, q̇, q̈) and in P, chained through the exact
+  // first derivatives of Γ (dynamics, contact wrenches, inner optimum) held in `b`:
+  //   H_s = Σ_j [c σ'' ∇P ∇Pᵀ + (c σ' + λ_P) J_jᵀ ∇²P J_j] + 2 c w E_q̈ᵀ E_q̈,
+  // J_j the rows (∇Γ_j, e_q̇j, e_q̈j). Left out: Σ_o λ_o ∇²y_o and (c σ' + λ_P) ∂P/∂Γ ∇²Γ_j, the
+  // curvature of the outputs themselves. The cross terms of ∇²P (the mechanical power Γem Ω
+  // is bilinear) make H_s indefinite; dropping them (a positive semidefinite model) was
+  // measured: the kick did not converge in 3000 iterations (docs/scenarios.md).
+  const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
+  auto H = h.stateHessian.topLeftCorner(d, d);
+  H.setZero();
+  const bool smooth = scenario_.energyForm == EnergyForm::SmoothMaximum;
+  auto gradientOf = [&](int output, Eigen::Ref<Eigen::VectorXd> row) {
+    row.segment(0, n) = b.dyDq.row(output).transpose();
+    row.segment(n, n) = b.dyDv.row(output).transpose();
+    row.segment(2 * n, n) = b.dyDa.row(output).transpose();
+    if (nf > 0) row.tail(nf) = b.dyDz.row(output).head(nf).transpose();
+  };
+  auto torqueGradient = h.base.head(d), powerGradient = h.gradient.head(d);
+  for (int j = 0; j < n; ++j) {
+    const double P = b.y[outputs_.power(j)];
+    const double slope =
+        multipliers[outputs_.power(j)] + (smooth ? objectiveWeight * smoothMaximumSlope(P, scenario_.smoothing) : 0.0);
+    const double curvature = smooth ? objectiveWeight * smoothMaximumCurvature(P, scenario_.smoothing) : 0.0;
+    if (curvature != 0.0) {
+      gradientOf(outputs_.power(j), powerGradient);
+      H.selfadjointView<Eigen::Lower>().rankUpdate(powerGradient, curvature);
+    }
+    if (slope == 0.0) continue;
+    gradientOf(outputs_.torque(j), torqueGradient);
+    const Eigen::Matrix3d M =
+        slope * motorPowerHessian(scenario_.actuators.joints[static_cast<std::size_t>(j)],
+                                  scenario_.actuators.frictionSharpness, b.y[outputs_.torque(j)], h.velocity[j],
+                                  b.acceleration[j]);
+    // J_jᵀ M J_j in the lower triangle: the Γ–Γ term as a rank-one update, the cross terms on
+    // the joint's own q̇ and q̈ columns (an entry on the diagonal takes both halves).
+    H.selfadjointView<Eigen::Lower>().rankUpdate(torqueGradient, M(0, 0));
+    const int v = n + j, a = 2 * n + j;
+    for (int r = 0; r < d; ++r) {
+      H(std::max(r, v), std::min(r, v)) += M(0, 1) * torqueGradient[r] * (r == v ? 2.0 : 1.0);
+      H(std::max(r, a), std::min(r, a)) += M(0, 2) * torqueGradient[r] * (r == a ? 2.0 : 1.0);
+    }
+    H(v, v) += M(1, 1);
+    H(a, v) += M(1, 2);
+    H(a, a) += M(2, 2);
+  }
+  for (int j = 0; j < n; ++j) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
+  H.triangularView<Eigen::StrictlyUpper>() = H.transpose();  // the spreading reads the whole matrix
 }
 
 void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,
@@ -89,7 +144,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // loop below works on leading blocks and allocates nothing.
     const int largest = 3 * n + static_cast<int>(forceColumns), largestLocal = 4 * n + static_cast<int>(forceColumns);
     for (HessianWorkspace& h : hessianWorkspaces_) {
-      h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
+      h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest), h.velocity.setZero(n);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
@@ -163,6 +218,12 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
       const double objectiveWeight = objectiveFactor * ((s == 0 || s == N - 1) ? 0.5 * dt : dt);
       const auto lambda = sampleMultipliers_.col(s);
+      if (scenario_.hessian == HessianOption::GaussNewton) {
+        samples_.evaluate(s, controlPoints_, T, w.q, h.velocity, w.a);  // the sample's q̇
+        sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)]);
+        continue;
+      }
       auto base = h.base.head(d), gradient = h.gradient.head(d);
       sampleLagrangianGradient(b, lambda, objectiveWeight, h, base);
       samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);

@@ -216,7 +216,7 @@ class MotionProblem final : public NlpProblem {
   void buildStructure();
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
-    Eigen::VectorXd probeX, weights, base, gradient;
+    Eigen::VectorXd probeX, weights, base, gradient, velocity;
     Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
   };
@@ -233,6 +233,10 @@ class MotionProblem final : public NlpProblem {
   /// outputs' derivatives in `b` and each output's multiplier (+ the objective's share).
   void sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  /// The gauss-newton option's H_s (HessianOption::GaussNewton) into h.stateHessian, from the
+  /// sample's outputs and derivatives in `b` and its joint velocities in h.velocity.
+  void sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                double objectiveWeight, HessianWorkspace& h) const;
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;

@@ -25,6 +25,7 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
     stage.smoothing = stageScenario.smoothing;
     stage.samples = stageScenario.samples;
+    stage.hessian = stageScenario.hessian;
     IpoptOutcome outcome;
     int joined = 0;
     for (;;) {
@@ -35,6 +36,14 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
       // keeps Ipopt near it instead of re-centring the iterate (ours first: the scenario's
       // `solver` options still override it).
       IpoptSettings roundSettings = settings;
+      roundSettings.problemHessian = stageScenario.hessian != HessianOption::LimitedMemory;
+      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations > 0) {
+        SolverOption limit;  // after the scenario's options: the stage's own limit wins
+        limit.name = "max_iter", limit.type = SolverOption::Type::Integer;
+        limit.integer = scenario.continuation[static_cast<std::size_t>(k)].maxIterations;
+        limit.text = std::to_string(limit.integer), limit.origin = "continuation stage: ";
+        roundSettings.options.push_back(limit);
+      }
       if (stage.rounds > 0) {
         SolverOption barrier;
         barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = 1e-4;

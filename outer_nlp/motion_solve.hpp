@@ -19,6 +19,7 @@ namespace mcopt {
 struct StageOutcome {
   double frictionSharpness = 0.0, smoothing = 0.0;
   int samples = 0;
+  HessianOption hessian = HessianOption::SampleDifferences;
   OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
   double objective = 0.0;                           ///< of its last solve
   int iterations = 0;                               ///< over its rounds

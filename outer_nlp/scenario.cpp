@@ -338,7 +338,8 @@ struct HessianName {
 constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited-memory"},
                                          {HessianOption::FiniteDifferences, "finite-differences"},
                                          {HessianOption::SampleDifferences, "sample-differences"},
-                                         {HessianOption::ConvexSampleDifferences, "convex-sample-differences"}};
+                                         {HessianOption::ConvexSampleDifferences, "convex-sample-differences"},
+                                         {HessianOption::GaussNewton, "gauss-newton"}};
 }  // namespace
 
 const char* toString(HessianOption hessian) {
@@ -350,7 +351,8 @@ const char* toString(HessianOption hessian) {
 HessianOption parseHessianOption(const std::string& name) {
   for (const HessianName& h : kHessianNames)
     if (name == h.name) return h.option;
-  throw InputError("expected limited-memory, finite-differences, sample-differences or convex-sample-differences, got '" +
+  throw InputError(
+      "expected limited-memory, finite-differences, sample-differences, convex-sample-differences or gauss-newton, got '" +
                    name + "'");
 }
 
@@ -522,8 +524,16 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       const YAML::Node stage = stages[k];
       const std::string field = "continuation[" + std::to_string(k) + "]";
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
-      yaml::rejectUnknownKeys(file, stage, field, {"friction_sharpness", "smoothing", "samples"});
-      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples};
+      yaml::rejectUnknownKeys(file, stage, field, {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations"});
+      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, 0};
+      if (stage["hessian"]) {
+        try {
+          c.hessian = parseHessianOption(yaml::text(file, stage["hessian"], field + ".hessian"));
+        } catch (const InputError& e) {
+          throw InputError(where(file, stage["hessian"], field + ".hessian") + e.what());
+        }
+      }
+      if (stage["max_iterations"]) c.maxIterations = integerField(file, stage["max_iterations"], field + ".max_iterations", 1);
       if (stage["friction_sharpness"])
         c.frictionSharpness = yaml::positive(file, stage["friction_sharpness"], field + ".friction_sharpness");
       if (stage["smoothing"]) {
@@ -557,6 +567,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
     stage.actuators.frictionSharpness = scenario.continuation[k].frictionSharpness;
     stage.smoothing = scenario.continuation[k].smoothing;
     stage.samples = scenario.continuation[k].samples;
+    stage.hessian = scenario.continuation[k].hessian;
   }
   return stage;
 }

@@ -61,9 +61,16 @@ enum class HessianOption {
   /// The same with each H_s (and each task instant's) projected onto the positive
   /// semidefinite cone (negative eigenvalues set to zero): a convex model, no inertia correction.
   ConvexSampleDifferences,
+  /// Σ_s B_sᵀ H_s B_s with H_s assembled from each sample's exact first derivatives (no
+  /// extra evaluation): the exact curvature of the energy and epigraph terms in the sample's
+  /// outputs (P in Γ, q̇, q̈; the smooth maximum in P) chained through the outputs' exact
+  /// Jacobian, the outputs' own curvature (∇²Γ, of the dynamics and the inner optimum)
+  /// left out — a Gauss–Newton model. Task instants as sample-differences.
+  GaussNewton,
 };
 const char* toString(HessianOption hessian);
-/// "limited-memory", "finite-differences", "sample-differences" or "convex-sample-differences";
+/// "limited-memory", "finite-differences", "sample-differences", "convex-sample-differences"
+/// or "gauss-newton";
 /// throws InputError otherwise.
 HessianOption parseHessianOption(const std::string& name);
 
@@ -149,12 +156,14 @@ struct Scenario {
     double frictionSharpness = 0.0;  ///< ν [s/rad]
     double smoothing = 0.0;          ///< ε [W]
     int samples = 0;                 ///< N: a coarser grid, the same spline parameters
+    HessianOption hessian = HessianOption::SampleDifferences;  ///< the scenario's unless the stage names one
+    int maxIterations = 0;           ///< Ipopt's max_iter for the stage; 0: the scenario's
   };
   std::vector<ContinuationStage> continuation;
 };
 
 /// Stage k of the scenario's continuation (k = continuation.size(): the scenario itself):
-/// a copy with that stage's friction sharpness, smoothing and samples.
+/// a copy with that stage's friction sharpness, smoothing, samples and Hessian option.
 Scenario continuationStage(const Scenario& scenario, std::size_t k);
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws

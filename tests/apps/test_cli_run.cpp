@@ -290,6 +290,33 @@ TEST_CASE("run: a continuation solves its stages in turn, each from the last one
   CHECK(split <= parts + 1e-9);
 }
 
+TEST_CASE("run: a continuation stage with its own Hessian option and iteration limit", "[cli][run]") {
+  // The bundled multi-contact scenarios start with a few hundred gauss-newton iterations and
+  // finish with sample-differences (docs/scenarios.md): each stage says its option, stops at its
+  // own limit (not the scenario's), and the next starts from its iterate.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 16;
+    root["hessian"] = "sample-differences";
+    root["continuation"] = YAML::Load("[{hessian: gauss-newton, max_iterations: 2}]");
+    root["solver"]["max_iter"] = 3;
+  });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --configuration-optimisation off");
+  INFO(r.all());
+  REQUIRE(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("Hessian: gauss-newton; stage 1 of 2") && Contains("Hessian: sample-differences; stage 2 of 2") &&
+                           Contains("(all stages: 2 + 3)"));
+  const Json result = readJson(out / "result.json");
+  REQUIRE(result["continuation"].size() == 2);
+  CHECK(result["continuation"][0]["hessian"] == "gauss-newton");
+  CHECK(result["continuation"][0]["iterations"] == 2);
+  CHECK(result["continuation"][1]["hessian"] == "sample-differences");
+  CHECK(result["continuation"][1]["iterations"] == 3);
+  REQUIRE(result["history"].size() == 7);
+  CHECK(result["history"][2]["seconds"]["hessian"].get<double>() > 0.0);  // the Gauss–Newton model was asked for
+}
+
 TEST_CASE("run: torque-limit screening solves again with the rows that came near their limit", "[cli][run]") {
   // A fraction so small that rows left out at the start reach it at the optimum: the run
   // solves again with them, ends optimal, and every row still left out holds — checked here
@@ -385,13 +412,18 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
        {"solver.max_iterations: Ipopt rejects option 'max_iterations'"}},
       {"Ipopt option out of range", [](YAML::Node& r) { r["solver"]["tol"] = -1.0; }, {"solver.tol: Ipopt rejects option 'tol'"}},
       {"unknown Hessian option", [](YAML::Node& r) { r["hessian"] = "exact"; },
-       {"hessian: expected limited-memory, finite-differences, sample-differences or convex-sample-differences, got 'exact'"}},
+       {"hessian: expected limited-memory, finite-differences, sample-differences, convex-sample-differences or gauss-newton, got 'exact'"}},
       {"continuation not a list", [](YAML::Node& r) { r["continuation"] = 3; }, {"continuation: expected a list"}},
       {"unknown continuation field", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{tol: 1.0}]"); },
        {"continuation[0].tol: unknown key"}},
       {"continuation sharpness not positive", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{samples: 25}, {friction_sharpness: 0.0}]");
        }, {"continuation[1].friction_sharpness: must be positive"}},
+      {"unknown continuation Hessian", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{hessian: newton}]"); },
+       {"continuation[0].hessian: expected limited-memory"}},
+      {"continuation iteration limit not positive", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{max_iterations: 0}]");
+       }, {"continuation[0].max_iterations: expected an integer ≥ 1"}},
       {"continuation samples with per-sample variables", [](YAML::Node& r) {
          r["objective"]["energy"] = "epigraph";
          r["objective"].remove("smoothing");

@@ -326,11 +326,14 @@ TEST_CASE("the sensitivity of degenerate samples allocates nothing once warm: we
 TEST_CASE("the outer problem's evaluation allocates nothing once warm: one contact and each multi-contact formulation",
           "[outer][allocation]") {
   // What Ipopt calls per iterate: objective, gradient, constraints, Jacobian values, Hessian.
+  // Each per-sample Hessian option: the differences and the Gauss–Newton model.
   for (const char* file : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml"})
-    for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
+    for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables})
+    for (const HessianOption option : {HessianOption::SampleDifferences, HessianOption::GaussNewton}) {
       Scenario scenario = loadScenario(test::sourceDir() / "scenarios" / file);
       scenario.samples = 20;
       scenario.contactForces = forces;
+      scenario.hessian = option;
       MotionProblem problem(scenario);
       Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end), gradient, constraints, jacobian, hessian;
       const Eigen::VectorXd multipliers = Eigen::VectorXd::Constant(problem.constraintCount(), 0.5);
@@ -340,7 +343,7 @@ TEST_CASE("the outer problem's evaluation allocates nothing once warm: one conta
         problem.objectiveGradient(x, gradient);
         problem.constraints(x, constraints);
         problem.jacobianValues(x, jacobian);
-        problem.lagrangianHessian(x, 1.0, multipliers, hessian);  // the sample-differences Hessian
+        problem.lagrangianHessian(x, 1.0, multipliers, hessian);
       };
       evaluateAll();  // set-up: buffers sized, inner solvers warm
       std::mt19937 rng(9);
@@ -349,7 +352,7 @@ TEST_CASE("the outer problem's evaluation allocates nothing once warm: one conta
       Measured measured;
       evaluateAll();
       const long during = measured.count();  // read before INFO, which allocates its message
-      INFO(file << ", " << toString(forces));
+      INFO(file << ", " << toString(forces) << ", " << toString(option));
       CHECK(during == 0);
       CHECK(std::isfinite(objective));
     }

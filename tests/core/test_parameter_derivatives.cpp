@@ -34,6 +34,44 @@ TEST_CASE("motor power derivatives match central differences", "[derivatives][en
   }
 }
 
+TEST_CASE("motor power Hessian matches central differences of its derivatives", "[derivatives][energy]") {
+  // The exact curvature the gauss-newton Hessian chains (core/actuators.hpp), every entry,
+  // at velocities inside the dry friction's steep region (ν Ω ≈ 1) and outside it.
+  ActuatorParameters m;
+  m.gearRatio = 160;
+  m.torqueConstant = 0.026;
+  m.resistance = 0.58;
+  m.rotorInertia = 7e-6;
+  m.viscousFriction = 2e-6;
+  m.dryFriction = 0.005;
+  std::mt19937 rng(5);
+  int compared = 0;
+  for (const double sharpness : {1.0, 0.01}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      const Eigen::VectorXd x = test::randomVector(rng, 3, 1.0);
+      const Eigen::Vector3d z(10 * x[0], (trial % 2 == 0 ? 0.01 : 1.0) * x[1], x[2]);
+      const Eigen::Matrix3d H = motorPowerHessian(m, sharpness, z[0], z[1], z[2]);
+      auto gradient = [&](const Eigen::Vector3d& p) {
+        const MotorPowerDerivatives d = motorPowerDerivatives(m, sharpness, p[0], p[1], p[2]);
+        return Eigen::Vector3d(d.dTorque, d.dVelocity, d.dAcceleration);
+      };
+      Eigen::Matrix3d fd;
+      for (int c = 0; c < 3; ++c) {
+        const double h = 1e-5 * (c == 1 ? 0.01 : 1.0);
+        Eigen::Vector3d plus = z, minus = z;
+        plus[c] += h, minus[c] -= h;
+        fd.col(c) = (gradient(plus) - gradient(minus)) / (2 * h);
+      }
+      CHECK((H - H.transpose()).cwiseAbs().maxCoeff() == 0.0);
+      // Entry by entry, relative to the entry (they span 1e-5 to 1e5: a scale-free check).
+      const double floor = 1e-9 * fd.cwiseAbs().maxCoeff();
+      CHECK(((H - fd).array().abs() / (fd.array().abs() + floor)).maxCoeff() <= 1e-6);
+      ++compared;
+    }
+  }
+  CHECK(compared == 40);
+}
+
 TEST_CASE("torque Jacobians and the energy gradient w.r.t. spline parameters and duration", "[derivatives][spline]") {
   std::mt19937 rng(31);
   for (const auto& named : test::allRobots()) {

@@ -12,6 +12,7 @@
 #include "common/test_support.hpp"
 #include "core/kinematics.hpp"
 #include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/smooth_maximum.hpp"
 
 namespace mcopt {
 
@@ -67,7 +68,114 @@ Scenario kick(int samples) {
 }
 
 
+/// The gauss-newton Hessian assembled independently of motion_hessian.cpp, from the public
+/// interface alone: ∇Γ_js from the torque-limit rows of the Jacobian, ∇q̇_js and ∇q̈_js
+/// from central differences of the sampled states (linear in x at a fixed duration), P and
+/// its curvature in (Γ, q̇, q̈) from core (tested against differences on its own):
+///   Σ_s,j [c_s σ'' ∇P ∇Pᵀ + (c_s σ' + λ_P) J_jsᵀ ∇²P J_js] + 2 c_s w ∇q̈ ∇q̈ᵀ.
+/// `epigraphMultipliers` (epigraph form): each epigraph row's multiplier, the row reading s − P.
+Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, double sigma,
+                                     const Eigen::VectorXd& multipliers) {
+  const Scenario& s = problem.scenario();
+  const int curved = problem.nonlinearVariableCount(), n = problem.model().jointCount();
+  const int N = problem.samples().sampleCount();
+  const double dt = problem.duration(x) / (N - 1);
+  Eigen::VectorXd values;
+  problem.jacobianValues(x, values);
+  Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(problem.constraintCount(), problem.variableCount());
+  for (Eigen::Index k = 0; k < values.size(); ++k) jacobian(problem.jacobianRows()[k], problem.jacobianColumns()[k]) += values[k];
+  const SampledPhysics physics = problem.sampledPhysics(x);
+  Eigen::VectorXd curvedX = x.head(curved);
+  auto states = [&](bool acceleration) {
+    return test::centralDifferences(curvedX, 1e-4, [&] {
+      Eigen::VectorXd probe = x;
+      probe.head(curved) = curvedX;
+      const SampledPhysics p = problem.sampledPhysics(probe);
+      return Eigen::VectorXd((acceleration ? p.a : p.v).reshaped());  // index s · n + j
+    });
+  };
+  const Eigen::MatrixXd dv = states(false), da = states(true);
+  std::vector<int> torqueRow(static_cast<std::size_t>(n * N), -1), epigraphRow(static_cast<std::size_t>(n * N), -1);
+  for (int r = 0; r < problem.constraintCount(); ++r) {
+    if (problem.rowKind(r) != ConstraintKind::TorqueLimit && problem.rowKind(r) != ConstraintKind::Epigraph) continue;
+    const std::string name = problem.rowName(r);  // "torque limit of J at sample S", "energy epigraph of J at sample S"
+    const std::size_t of = name.find(" of ") + 4, at = name.find(" at sample ");
+    const int joint = s.robot.findJoint(name.substr(of, at - of)), sample = std::stoi(name.substr(at + 11));
+    REQUIRE(joint >= 0);
+    (problem.rowKind(r) == ConstraintKind::TorqueLimit ? torqueRow : epigraphRow)[static_cast<std::size_t>(sample * n + joint)] = r;
+  }
+  const bool smooth = s.energyForm == EnergyForm::SmoothMaximum;
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(curved, curved);
+  for (int sample = 0; sample < N; ++sample) {
+    const double c = sigma * ((sample == 0 || sample == N - 1) ? 0.5 * dt : dt);
+    for (int j = 0; j < n; ++j) {
+      const auto k = static_cast<std::size_t>(sample * n + j);
+      REQUIRE(torqueRow[k] >= 0);
+      const ActuatorParameters& motor = s.actuators.joints[static_cast<std::size_t>(j)];
+      const double tau = physics.tau(j, sample), v = physics.v(j, sample), a = physics.a(j, sample);
+      const MotorPowerDerivatives d = motorPowerDerivatives(motor, s.actuators.frictionSharpness, tau, v, a);
+      Eigen::MatrixXd J(3, curved);
+      J.row(0) = jacobian.row(torqueRow[k]).head(curved);
+      J.row(1) = dv.row(static_cast<Eigen::Index>(k));
+      J.row(2) = da.row(static_cast<Eigen::Index>(k));
+      const Eigen::RowVectorXd power = d.dTorque * J.row(0) + d.dVelocity * J.row(1) + d.dAcceleration * J.row(2);
+      double slope = 0.0;
+      if (smooth) {
+        slope = c * smoothMaximumSlope(d.power, s.smoothing);
+        h += c * smoothMaximumCurvature(d.power, s.smoothing) * power.transpose() * power;
+      } else {
+        REQUIRE(epigraphRow[k] >= 0);
+        slope = -multipliers[epigraphRow[k]];
+      }
+      h += slope * J.transpose() * motorPowerHessian(motor, s.actuators.frictionSharpness, tau, v, a) * J;
+      h += 2.0 * c * s.accelerationWeight * J.row(2).transpose() * J.row(2);
+    }
+  }
+  return h;
+}
+
 }  // namespace
+
+TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jacobian and the states", "[outer][hessian]") {
+  // What the option computes is a model (docs/scenarios.md): this checks that it is the
+  // model it says — the chain through every sample's exact output derivatives, the local
+  // supports, the trapezoid weights — on one contact (smooth maximum with regularisation,
+  // and the epigraph form) and on the bilevel formulation (Γ through the inner optimum).
+  struct Case {
+    const char* name;
+    bool epigraph, bilevel;
+  };
+  int compared = 0;
+  for (const Case& c : {Case{"kick, smooth maximum, regularised", false, false}, Case{"kick, epigraph", true, false},
+                        Case{"lean reach, bilevel", false, true}}) {
+    Scenario s = c.bilevel ? loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml") : kick(12);
+    s.samples = c.bilevel ? 8 : 12;
+    s.outputSamples = 20;
+    s.hessian = HessianOption::GaussNewton;
+    if (c.bilevel) s.contactForces = ContactForces::Bilevel;
+    if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
+    if (!c.bilevel && !c.epigraph) s.accelerationWeight = 1e-3;
+    MotionProblem problem(s);
+    const Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 17);
+    // Multipliers on the epigraph rows alone (the model leaves the other rows' curvature out).
+    Eigen::VectorXd lambda = Eigen::VectorXd::Zero(problem.constraintCount());
+    const Eigen::VectorXd random = randomMultipliers(problem, 19);
+    for (int r = 0; r < problem.constraintCount(); ++r)
+      if (problem.rowKind(r) == ConstraintKind::Epigraph) lambda[r] = random[r];
+    const double sigma = c.epigraph ? 0.0 : 0.8;
+    Eigen::VectorXd values;
+    problem.lagrangianHessian(x, sigma, lambda, values);
+    const int curved = problem.nonlinearVariableCount();
+    const Eigen::MatrixXd h = dense(values, curved), reference = gaussNewtonReference(problem, x, sigma, lambda);
+    const double scale = reference.cwiseAbs().maxCoeff();
+    INFO(c.name << ": largest entry " << scale << ", worst difference " << (h - reference).cwiseAbs().maxCoeff());
+    REQUIRE(scale > 0.0);
+    CHECK((h - reference).cwiseAbs().maxCoeff() <= 1e-7 * scale);
+    if (c.bilevel) CHECK(problem.infeasibleSamples() == 0);  // Γ has its derivative through the KKT system everywhere
+    ++compared;
+  }
+  CHECK(compared == 3);
+}
 
 TEST_CASE("sample-differences Hessian: the kick against differences of the exact gradient", "[outer][hessian]") {
   struct Case {
