@@ -168,7 +168,8 @@ Runner addRun(CLI::App& command) {
   command.add_option("--contact-forces", o->contactForces,
                      "bilevel, splines or variables: override the scenario's contact_forces (formulation.md §9)")
       ->check(CLI::IsMember({"bilevel", "splines", "variables"}));
-  command.add_option("--max-iterations", o->maxIterations, "override Ipopt's max_iter for the motion");
+  command.add_option("--max-iterations", o->maxIterations,
+                     "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,
                      "active-set, slsqp or ipopt: override the scenario's inner.solver (bilevel, formulation.md §7)")
       ->check(CLI::IsMember(innerSolverNames()));

@@ -32,22 +32,24 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
       MotionProblem current(stageScenario, omitted);
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
       if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
-      // A screening round starts at the previous round's optimum: a small barrier parameter
-      // keeps Ipopt near it instead of re-centring the iterate (ours first: the scenario's
-      // `solver` options still override it).
       IpoptSettings roundSettings = settings;
       roundSettings.problemHessian = stageScenario.hessian != HessianOption::LimitedMemory;
-      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations > 0) {
+      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations >= 0) {
         SolverOption limit;  // after the scenario's options: the stage's own limit wins
         limit.name = "max_iter", limit.type = SolverOption::Type::Integer;
         limit.integer = scenario.continuation[static_cast<std::size_t>(k)].maxIterations;
         limit.text = std::to_string(limit.integer), limit.origin = "continuation stage: ";
         roundSettings.options.push_back(limit);
       }
-      if (stage.rounds > 0) {
+      // A later stage, and a screening round, starts at the iterate the last solve ended on: a
+      // small barrier parameter keeps Ipopt near it instead of re-centring it (measured on the
+      // bilevel weight shift: from the Gauss–Newton stage's iterate, sample-differences ended
+      // optimal after 79 iterations with it, and not in 1000 without it; docs/scenarios.md).
+      // Ours first: the scenario's `solver` options still override it.
+      if (k > 0 || stage.rounds > 0) {
         SolverOption barrier;
         barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = 1e-4;
-        barrier.text = "1e-4", barrier.origin = "torque-limit screening: ";
+        barrier.text = "1e-4", barrier.origin = stage.rounds > 0 ? "torque-limit screening: " : "continuation stage: ";
         roundSettings.options.insert(roundSettings.options.begin(), barrier);
       }
       outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
@@ -71,6 +73,17 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     if (usable) x = outcome.x;
     stage.status = outcome.status, stage.objective = outcome.objective;
     result.stages.push_back(stage);
+    // A stage that differs from the scenario's own problem only in its Hessian option (or
+    // iteration limit) and ends optimal has solved that problem: Ipopt's optimality test reads
+    // the exact first derivatives, whatever Hessian shaped the steps. The later stages would
+    // only restart from its optimum (measured: a restart with sample-differences wandered off
+    // the lean reach's optimum; docs/scenarios.md).
+    const bool scenarioProblem = stageScenario.actuators.frictionSharpness == scenario.actuators.frictionSharpness &&
+                                 stageScenario.smoothing == scenario.smoothing && stageScenario.samples == scenario.samples;
+    if (!last && scenarioProblem && usable && outcome.optimal()) {
+      result.solver = outcome;
+      break;
+    }
     if (last || outcome.status == OuterStatus::Interrupted || !usable) {
       result.solver = outcome;
       if (!last) {

@@ -525,7 +525,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       const std::string field = "continuation[" + std::to_string(k) + "]";
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
       yaml::rejectUnknownKeys(file, stage, field, {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations"});
-      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, 0};
+      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1};
       if (stage["hessian"]) {
         try {
           c.hessian = parseHessianOption(yaml::text(file, stage["hessian"], field + ".hessian"));

@@ -157,7 +157,7 @@ struct Scenario {
     double smoothing = 0.0;          ///< ε [W]
     int samples = 0;                 ///< N: a coarser grid, the same spline parameters
     HessianOption hessian = HessianOption::SampleDifferences;  ///< the scenario's unless the stage names one
-    int maxIterations = 0;           ///< Ipopt's max_iter for the stage; 0: the scenario's
+    int maxIterations = -1;          ///< Ipopt's max_iter for the stage; -1: the scenario's
   };
   std::vector<ContinuationStage> continuation;
 };

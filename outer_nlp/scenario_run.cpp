@@ -1,5 +1,6 @@
 #include "outer_nlp/scenario_run.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "core/errors.hpp"
@@ -57,6 +58,9 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
     limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
     limit.origin = "--max-iterations: ";
     scenario.solverOptions.push_back(limit);
+    // Every continuation stage too: the override bounds the whole run's work, stage by stage.
+    for (Scenario::ContinuationStage& stage : scenario.continuation)
+      stage.maxIterations = stage.maxIterations < 0 ? o.maxIterations : std::min(stage.maxIterations, o.maxIterations);
   }
 }
 

@@ -118,6 +118,7 @@ def run(mcopt, scenario, out, arguments, time_limit):
     iterations = r["solver"].get("iterations_all_stages", r["solver"]["iterations"])
     return {"scenario": pathlib.Path(scenario).name, "arguments": arguments, "status": r["status"],
             "stopped_at_time_limit": stopped, "exit_code": child.returncode, "iterations": iterations,
+            "stages": len(r.get("continuation") or [None]),
             "seconds": round(seconds, 2), "seconds_per_iteration": round(seconds / max(iterations, 1), 3),
             "energy_J": r["energy"], "criterion": r["objective_value"], "max_violation": r["max_violation"]}
 

@@ -317,6 +317,32 @@ TEST_CASE("run: a continuation stage with its own Hessian option and iteration l
   CHECK(result["history"][2]["seconds"]["hessian"].get<double>() > 0.0);  // the Gauss–Newton model was asked for
 }
 
+TEST_CASE("run: a Hessian-only stage that ends optimal ends the run", "[cli][run]") {
+  // The stage differs from the scenario's problem only in its Hessian: optimal there is optimal
+  // for the scenario (Ipopt's test reads the exact first derivatives), so no later stage runs;
+  // a stage with another friction sharpness hands its iterate on to the scenario's problem.
+  const test::TempDir dir;
+  for (const bool sameProblem : {true, false}) {
+    if (kUnderSanitizers && !sameProblem) continue;  // the Release build runs both
+    const auto scenario = kickVariant(dir, [&](YAML::Node& root) {
+      root["samples"] = 12;
+      root["continuation"] = YAML::Load(sameProblem ? "[{hessian: gauss-newton}]"
+                                                    : "[{hessian: gauss-newton, friction_sharpness: 0.5, max_iterations: 3}]");
+    });
+    const auto out = dir.path() / (sameProblem ? "same" : "other");
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --configuration-optimisation off");
+    INFO(r.all());
+    REQUIRE(r.exitCode == 0);
+    const Json result = readJson(out / "result.json");
+    CHECK(result["status"] == "optimal");
+    REQUIRE(result["continuation"].size() == (sameProblem ? 1u : 2u));
+    CHECK(result["continuation"][0]["status"] == (sameProblem ? "optimal" : "maximum_iterations"));
+    CHECK(result["continuation"][0]["hessian"] == "gauss-newton");
+    CHECK(result["solver"]["iterations"] == result["continuation"].back()["iterations"]);
+    CHECK_FALSE(result.contains("reason"));
+  }
+}
+
 TEST_CASE("run: torque-limit screening solves again with the rows that came near their limit", "[cli][run]") {
   // A fraction so small that rows left out at the start reach it at the optimum: the run
   // solves again with them, ends optimal, and every row still left out holds — checked here
@@ -460,6 +486,7 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
     const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
       root["samples"] = 16;
       root["hessian"] = "limited-memory";
+      root.remove("continuation");
     }, "weight_shift.yaml");
     const auto out = dir.path() / forces;
     // The start and end postures as the scenario gives them: what is checked here is the
@@ -521,6 +548,7 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
     const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
       root["samples"] = ipopt ? 8 : 16;
       root["hessian"] = "limited-memory";
+      root.remove("continuation");
       root["inner"]["solver"] = solver;
     }, std::string("weight_shift_") + solver + ".yaml");
     const auto out = dir.path() / solver;

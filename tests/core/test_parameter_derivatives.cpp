@@ -13,7 +13,10 @@
 
 using namespace mcopt;
 
-TEST_CASE("motor power derivatives match central differences", "[derivatives][energy]") {
+namespace {
+
+/// A motor with every term of the power model at HRP-2's scale.
+ActuatorParameters testMotor() {
   ActuatorParameters m;
   m.gearRatio = 160;
   m.torqueConstant = 0.026;
@@ -21,6 +24,13 @@ TEST_CASE("motor power derivatives match central differences", "[derivatives][en
   m.rotorInertia = 7e-6;
   m.viscousFriction = 2e-6;
   m.dryFriction = 0.005;
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("motor power derivatives match central differences", "[derivatives][energy]") {
+  const ActuatorParameters m = testMotor();
   std::mt19937 rng(2);
   for (int trial = 0; trial < 20; ++trial) {
     const Eigen::VectorXd x = test::randomVector(rng, 3, 3.0);
@@ -37,13 +47,7 @@ TEST_CASE("motor power derivatives match central differences", "[derivatives][en
 TEST_CASE("motor power Hessian matches central differences of its derivatives", "[derivatives][energy]") {
   // The exact curvature the gauss-newton Hessian chains (core/actuators.hpp), every entry,
   // at velocities inside the dry friction's steep region (ν Ω ≈ 1) and outside it.
-  ActuatorParameters m;
-  m.gearRatio = 160;
-  m.torqueConstant = 0.026;
-  m.resistance = 0.58;
-  m.rotorInertia = 7e-6;
-  m.viscousFriction = 2e-6;
-  m.dryFriction = 0.005;
+  const ActuatorParameters m = testMotor();
   std::mt19937 rng(5);
   int compared = 0;
   for (const double sharpness : {1.0, 0.01}) {

@@ -254,7 +254,7 @@ TEST_CASE("study: the inner solver and the contact-force formulation vary like a
   REQUIRE(cases.size() == 6);
   CHECK(cases[4].scenario["contact_forces"].as<std::string>() == "splines");
   CHECK(cases[4].scenario["inner"]["solver"].as<std::string>() == "slsqp");
-  CHECK(cases[4].scenario["inner"]["contact_model"].as<std::string>() == "report");  // the rest of `inner` kept
+  CHECK(cases[4].scenario["inner"]["contact_model"].as<std::string>() == "wrench-cone");  // the rest of `inner` kept
   REQUIRE_NOTHROW(validateCases(sweep, cases));
   const auto bad = dir.write("bad.yaml", "scenario: " + (test::sourceDir() / "scenarios/hrp2_weight_shift.yaml").string() +
                                              "\nvary:\n  - {field: inner.solver, values: [active-set, cplex]}\n");
