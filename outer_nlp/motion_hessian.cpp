@@ -94,7 +94,7 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
     gradientOf(outputs_.torque(j), torqueGradient);
     const Eigen::Matrix3d M =
         slope * motorPowerHessian(scenario_.actuators.joints[static_cast<std::size_t>(j)],
-                                  scenario_.actuators.frictionSharpness, b.y[outputs_.torque(j)], h.velocity[j],
+                                  scenario_.actuators.frictionSharpness, b.y[outputs_.torque(j)], b.velocity[j],
                                   b.acceleration[j]);
     // J_jᵀ M J_j in the lower triangle: the Γ–Γ term as a rank-one update, the cross terms on
     // the joint's own q̇ and q̈ columns (an entry on the diagonal takes both halves).
@@ -144,7 +144,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // loop below works on leading blocks and allocates nothing.
     const int largest = 3 * n + static_cast<int>(forceColumns), largestLocal = 4 * n + static_cast<int>(forceColumns);
     for (HessianWorkspace& h : hessianWorkspaces_) {
-      h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest), h.velocity.setZero(n);
+      h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
@@ -154,7 +154,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
     for (SampleBlock& p : probes_) {
-      p.y.setZero(outputs), p.wrenches.setZero(6 * (1 + contacts)), p.acceleration.setZero(n);
+      p.y.setZero(outputs), p.wrenches.setZero(6 * (1 + contacts)), p.velocity.setZero(n), p.acceleration.setZero(n);
       p.dyDq.setZero(outputs, n), p.dyDv.setZero(outputs, n), p.dyDa.setZero(outputs, n);
       p.dyDz.setZero(outputs, static_cast<Eigen::Index>(forceColumns));
     }
@@ -219,7 +219,6 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const double objectiveWeight = objectiveFactor * ((s == 0 || s == N - 1) ? 0.5 * dt : dt);
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
-        samples_.evaluate(s, controlPoints_, T, w.q, h.velocity, w.a);  // the sample's q̇
         sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
         spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)]);
         continue;

@@ -437,6 +437,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
   else
     inverseDynamics(model_, w.data, w.q, w.v, w.a);
   const DynamicsDerivatives& d = w.derivatives;
+  b.velocity = w.v;
   b.acceleration = w.a;
   b.wrenches.setZero();
 

@@ -181,6 +181,7 @@ class MotionProblem final : public NlpProblem {
  private:
   struct SampleBlock {
     Eigen::VectorXd y;             ///< outputs, SampleOutputs order
+    Eigen::VectorXd velocity;      ///< q̇ (n), for the gauss-newton Hessian's ∇²P
     Eigen::VectorXd acceleration;  ///< q̈ (n), for the regularisation
     Eigen::VectorXd wrenches;      ///< 6 (1 + contacts): each contact's wrench in its frame (zero when inactive)
     Eigen::MatrixXd dyDx;          ///< rows × local parameters
@@ -216,7 +217,7 @@ class MotionProblem final : public NlpProblem {
   void buildStructure();
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
-    Eigen::VectorXd probeX, weights, base, gradient, velocity;
+    Eigen::VectorXd probeX, weights, base, gradient;
     Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
   };
@@ -234,7 +235,7 @@ class MotionProblem final : public NlpProblem {
   void sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// The gauss-newton option's H_s (HessianOption::GaussNewton) into h.stateHessian, from the
-  /// sample's outputs and derivatives in `b` and its joint velocities in h.velocity.
+  /// sample's state, outputs and derivatives in `b`.
   void sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h) const;
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
