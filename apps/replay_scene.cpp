@@ -131,12 +131,33 @@ Json replayScene(const Json& result, const std::filesystem::path& file) {
     contacts.push_back({surface, &node, out});
   }
 
+  // A throw's ball (result.json `release`): carried by its body up to the release, then its
+  // flight, which the page computes at any instant from the release state.
+  const Json* release = result.contains("release") && !result["release"].is_null() ? &result["release"] : nullptr;
+  int ballFrame = -1;
+  Vector3 ballPoint = Vector3::Zero();
+  Json ball;
+  if (release) {
+    const std::string body = text(file, member(file, *release, "body"), "release.body");
+    ballFrame = robot.findFrame(body);
+    if (ballFrame < 0) throw InputError(file.string() + ": release.body: '" + body + "' is not a link of " + urdf.string());
+    ballPoint = numbers(file, member(file, *release, "point"), "release.point", 3);
+    const double releaseTime = member(file, *release, "time").get<double>();
+    ball = {{"release_time", releaseTime},
+            {"position", vector3(numbers(file, member(file, *release, "position"), "release.position", 3))},
+            {"velocity", vector3(numbers(file, member(file, *release, "velocity"), "release.velocity", 3))},
+            {"flight_time", member(file, *release, "flight_time").get<double>()},
+            {"target", vector3(numbers(file, member(file, *release, "target"), "release.target", 3))},
+            {"carried", Json::array()}};
+  }
+
   Json centerOfMassTrack = Json::array();
   double floorHeight = 0.0;
   for (std::size_t k = 0; k < N; ++k) {
     forwardKinematics(model, data, postures[k]);
     for (std::size_t b = 0; b < robot.bodies.size(); ++b) bodies[b]["poses"].push_back(pose7(framePose(model, data, bodyFrames[b])));
     centerOfMassTrack.push_back(vector3(centerOfMass(model, data)));
+    if (release) ball["carried"].push_back(vector3(framePose(model, data, ballFrame).apply(ballPoint)));
     for (std::size_t c = 0; c < contacts.size(); ++c) {
       ContactTrack& track = contacts[c];
       const std::string field = "contacts[" + std::to_string(c) + "]";
@@ -178,6 +199,7 @@ Json replayScene(const Json& result, const std::filesystem::path& file) {
   scene["contacts"] = Json::array();
   for (const ContactTrack& track : contacts) scene["contacts"].push_back(track.out);
   scene["center_of_mass"] = centerOfMassTrack;
+  scene["ball"] = release ? ball : Json(nullptr);
   return scene;
 }
 

@@ -113,13 +113,14 @@ int runMotion(const RunOptions& o) {
                 << " of their limit checked afterwards";
     std::cout << ")\n"
               << "   iter      energy [J]   violation   dual inf.     elapsed"
-              << (solve.problem.bilevel() ? "   infeasible samples" : "") << "\n";
+              << (solve.problem.bilevel() ? "   infeasible samples" : "") << (scenario.ball ? "   miss [m]" : "") << "\n";
     lastCheckpoint = 0.0;
   };
   events.onIteration = [&](const RunRecord& sofar, const MotionProblem& current, const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
     if (current.bilevel()) std::printf("   %d", sofar.history.back().inner.infeasible);
+    if (r.iterate != nullptr && scenario.ball) std::printf("   %.3e", current.release(*r.iterate)->missDistance);
     std::printf("\n");
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&

@@ -1,5 +1,6 @@
 #include "apps/run_output.hpp"
 
+#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -123,6 +124,27 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
                        {"status", r.innerStatus},
                        {"infeasible_samples", r.infeasibleSamples},
                        {"failed_samples", r.failedSamples}};
+  if (r.release) {
+    // The ball at its release and its flight to the target's height (formulation.md §10).
+    const ReleaseState& b = *r.release;
+    const auto landing = std::find_if(scenario.tasks.begin(), scenario.tasks.end(),
+                                      [](const TaskSpec& t) { return t.kind == TaskKind::ThrowLanding; });
+    result["release"] = {{"time", b.time},
+                         {"body", scenario.ball->body},
+                         {"ball_mass_kg", scenario.ball->mass},
+                         {"point", toJson(scenario.ball->point)},
+                         {"position", toJson(b.position)},
+                         {"velocity", toJson(b.velocity)},
+                         {"speed_m_s", b.speed},
+                         {"elevation_deg", b.elevation * 180.0 / 3.14159265358979323846},
+                         {"flight_time", b.flightTime},
+                         {"apex_above_target_m", b.apexAboveTarget},
+                         {"target", toJson(landing->target)},
+                         {"target_half_widths_m", toJson(Eigen::Vector2d(landing->upper.head<2>()))},
+                         {"landing_point", toJson(b.landing)},
+                         {"miss_distance_m", b.missDistance},
+                         {"miss_outside_target_box_m", b.missOutsideBox}};
+  }
   result["power"] = matrixToJson(r.power.transpose());
   if (fine)
     result["power_fine"] = {{"time", toJson(r.fineTime)}, {"power", matrixToJson(r.finePower.transpose())}};

@@ -38,6 +38,17 @@ void BodyInertia::add(const BodyInertia& other, const RigidTransform& placement)
   mass = totalMass;
 }
 
+RobotModel withPointMass(RobotModel robot, int frame, const Vector3& point, double mass) {
+  if (frame < 0 || frame >= static_cast<int>(robot.frames.size()))
+    throw InputError(robot.source + ": withPointMass: no frame " + std::to_string(frame));
+  const Frame& f = robot.frames[static_cast<std::size_t>(frame)];
+  BodyInertia pointMass;
+  pointMass.mass = mass;
+  pointMass.com = point;
+  robot.bodies[static_cast<std::size_t>(f.body)].inertia.add(pointMass, f.placement);
+  return robot;
+}
+
 double RobotModel::totalMass() const {
   double sum = 0.0;
   for (const Body& body : bodies) sum += body.inertia.mass;

@@ -80,6 +80,11 @@ class RobotModel {
   std::vector<std::string> jointNames() const;
 };
 
+/// The robot carrying a point mass `mass` [kg] at `point` of frame `frame` (its frame's
+/// coordinates), added to the frame's body: a held object, e.g. the ball of a throw
+/// (formulation.md §10).
+RobotModel withPointMass(RobotModel robot, int frame, const Vector3& point, double mass);
+
 struct UrdfOptions {
   /// Inertias that are not positive definite or break the triangle inequality by more than
   /// 1e-5 kg m² are errors; with this set they become warnings (Romeo's published URDF

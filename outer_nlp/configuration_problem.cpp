@@ -26,7 +26,7 @@ ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const Dynam
     for (int c = 0; c < 6; ++c) rowTask_.push_back(-1), rowComponent_.push_back(c);
   for (std::size_t t = 0; t < scenario.tasks.size(); ++t) {
     const TaskSpec& task = scenario.tasks[t];
-    if (task.kind == TaskKind::LinearVelocity || task.kind == TaskKind::AngularVelocity) continue;
+    if (taskReadsVelocity(task.kind)) continue;
     if (instant < task.start - 1e-9 || instant > task.end + 1e-9) continue;
     tasks_.push_back(static_cast<int>(t));
     for (int c = 0; c < 3; ++c)

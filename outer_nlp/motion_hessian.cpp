@@ -117,7 +117,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                                              Eigen::VectorXd& values) {
   evaluate(x, true);
   const int n = jointCount_, curved = nonlinearVariableCount(), N = samples_.sampleCount();
-  const double T = duration(x), dt = T / (N - 1);
+  const double T = duration(x);
 
   // Each row's multiplier on the output it reads (an epigraph row reads −P).
   sampleMultipliers_.setZero(outputs_.size(), N);
@@ -216,7 +216,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     for (int s = 0; s < N; ++s) {
       const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
       const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
-      const double objectiveWeight = objectiveFactor * ((s == 0 || s == N - 1) ? 0.5 * dt : dt);
+      const double objectiveWeight = objectiveFactor * sampleWeights_[static_cast<std::size_t>(s)] * T;
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
         sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
@@ -255,7 +255,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
       // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
       const TaskKind kind = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])].kind;
-      const bool velocity = kind == TaskKind::LinearVelocity || kind == TaskKind::AngularVelocity;
+      const bool velocity = taskReadsVelocity(kind);
       const int d = velocity ? 2 * n : n;
       auto base = h.base.head(d), gradient = h.gradient.head(d);
       base.head(n).noalias() = b.dyDq.transpose() * lambda;

@@ -13,6 +13,7 @@
 #include "core/no_malloc_scope.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/ballistic_flight.hpp"
 #include "outer_nlp/motion_workspace.hpp"
 #include "outer_nlp/smooth_maximum.hpp"
 #include "sensitivity/bilevel_sample.hpp"
@@ -52,9 +53,16 @@ std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInst
   return u;
 }
 
-std::vector<double> sampleTimes(int count) {
-  std::vector<double> u(static_cast<std::size_t>(count));
-  for (int s = 0; s < count; ++s) u[static_cast<std::size_t>(s)] = static_cast<double>(s) / (count - 1);
+/// The regular samples u_s = s / (N − 1) and, with a thrown ball, the release sample twice:
+/// first loaded (the ball still in the hand), then released (formulation.md §10).
+std::vector<double> nlpSampleTimes(const Scenario& scenario) {
+  const int N = scenario.samples;
+  std::vector<double> u;
+  for (int s = 0; s < N; ++s) u.push_back(static_cast<double>(s) / (N - 1));
+  if (scenario.ball) {
+    const auto release = static_cast<std::size_t>(std::lround(scenario.ball->releaseTime / scenario.duration.initial * (N - 1)));
+    u.insert(u.begin() + static_cast<std::ptrdiff_t>(release), u[release]);
+  }
   return u;
 }
 
@@ -86,14 +94,30 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     : scenario_(scenario),
       model_(scenario.robot, scenario.referenceBody, scenario.referencePose, scenario.gravity),
       parametrization_(scenario.robot.jointCount(), scenario.controlPoints),
-      samples_(parametrization_, scenario.samples),
+      samples_(parametrization_, nlpSampleTimes(scenario)),
       taskSamples_(parametrization_, taskInstants(scenario, taskOfInstant_)),
       support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm()),
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
+  // Trapezoid weights as fractions of T: c_s / (N − 1), halved at the ends and, with a ball,
+  // at the release's two samples (the power jumps there; each side takes its half interval).
+  sampleTimes_ = nlpSampleTimes(scenario_);
+  const int count = samples_.sampleCount();
+  sampleWeights_.assign(static_cast<std::size_t>(count), 1.0 / (scenario_.samples - 1));
+  sampleWeights_.front() *= 0.5, sampleWeights_.back() *= 0.5;
+  loaded_.assign(static_cast<std::size_t>(count), false);
+  if (scenario_.ball) {
+    const ThrownBall& ball = *scenario_.ball;
+    loadedModel_ = std::make_unique<DynamicsModel>(withPointMass(scenario.robot, ball.frame, ball.point, ball.mass),
+                                                   scenario.referenceBody, scenario.referencePose, scenario.gravity);
+    releaseSample_ = static_cast<int>(std::lround(ball.releaseTime / scenario_.duration.initial * (scenario_.samples - 1)));
+    for (int s = 0; s <= releaseSample_; ++s) loaded_[static_cast<std::size_t>(s)] = true;
+    sampleWeights_[static_cast<std::size_t>(releaseSample_)] *= 0.5;
+    sampleWeights_[static_cast<std::size_t>(releaseSample_) + 1] *= 0.5;
+  }
   omittedTorqueRows_ = std::move(omittedTorqueRows);
-  if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * scenario_.samples))
+  if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
     throw InputError("motion problem: the torque-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());
   outputs_.joints = jointCount_, outputs_.contacts = contacts;
@@ -106,13 +130,13 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
   if (contacts > 0 && !bilevel_)
     forces_ = std::make_unique<ContactForceParametrization>(scenario_.contactForces, windows_,
-                                                            sampleTimes(scenario_.samples), scenario_.forceControlPoints,
+                                                            sampleTimes_, scenario_.forceControlPoints,
                                                             forceStart_);
   slackStart_ = forceStart_ + forceVariableCount();
-  variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * scenario_.samples : 0);
+  variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * count : 0);
   if (bilevel_) {
-    for (int s = 0; s < scenario_.samples; ++s)
-      bilevelSamples_.push_back(std::make_unique<BilevelSample>(model_, surfacesInContact(s), scenario_.inner,
+    for (int s = 0; s < count; ++s)
+      bilevelSamples_.push_back(std::make_unique<BilevelSample>(modelOf(s), surfacesInContact(s), scenario_.inner,
                                                                 scenario_.sensitivity, weight_));
   }
 
@@ -182,7 +206,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
 MotionProblem::~MotionProblem() = default;
 
 bool MotionProblem::contactActive(int contact, int sample) const {
-  return insideWindow(static_cast<double>(sample) / (samples_.sampleCount() - 1), windows_[static_cast<std::size_t>(contact)]);
+  return insideWindow(sampleTimes_[static_cast<std::size_t>(sample)], windows_[static_cast<std::size_t>(contact)]);
 }
 
 std::vector<ContactSurface> MotionProblem::surfacesInContact(int sample) const {
@@ -194,8 +218,8 @@ std::vector<ContactSurface> MotionProblem::surfacesInContact(int sample) const {
 
 std::vector<bool> MotionProblem::torquesBelow(const Eigen::VectorXd& x, double fraction) {
   evaluate(x, false);
-  std::vector<bool> below(static_cast<std::size_t>(jointCount_ * scenario_.samples), true);
-  for (int s = 0; s < scenario_.samples; ++s)
+  std::vector<bool> below(static_cast<std::size_t>(jointCount_ * samples_.sampleCount()), true);
+  for (int s = 0; s < samples_.sampleCount(); ++s)
     for (const int j : torqueJoints_) {
       const double limit = scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit;
       below[static_cast<std::size_t>(s * jointCount_ + j)] =
@@ -206,7 +230,7 @@ std::vector<bool> MotionProblem::torquesBelow(const Eigen::VectorXd& x, double f
 
 int MotionProblem::omittedTorqueRowCount() const {
   int count = 0;
-  for (int s = 0; s < scenario_.samples && !omittedTorqueRows_.empty(); ++s)
+  for (int s = 0; s < samples_.sampleCount() && !omittedTorqueRows_.empty(); ++s)
     for (const int j : torqueJoints_) count += omittedTorqueRows_[static_cast<std::size_t>(s * jointCount_ + j)];
   return count;
 }
@@ -390,21 +414,21 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
   if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
     // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).
-    std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, scenario_.samples));
+    std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, samples_.sampleCount()));
     ThreadWorkspace& w = workspaces_.front();
     Eigen::MatrixXd controlPoints;
     parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
     std::unique_ptr<BilevelSample> previous;
-    for (int s = 0; s < scenario_.samples; ++s) {
+    for (int s = 0; s < samples_.sampleCount(); ++s) {
       std::vector<int> which;
       for (int i = 0; i < outputs_.contacts; ++i)
         if (contactActive(i, s)) which.push_back(i);
       samples_.evaluate(s, controlPoints, duration(x), w.q, w.v, w.a);
-      inverseDynamics(model_, w.data, w.q, w.v, w.a);
+      inverseDynamics(modelOf(s), w.data, w.q, w.v, w.a);
       auto sample =
-          std::make_unique<BilevelSample>(model_, surfacesInContact(s), scenario_.inner, scenario_.sensitivity, weight_);
+          std::make_unique<BilevelSample>(modelOf(s), surfacesInContact(s), scenario_.inner, scenario_.sensitivity, weight_);
       if (previous) sample->warmStartFrom(*previous);
-      sample->evaluate(model_, w.data, nullptr, scenario_.actuators, w.v, w.a, false);
+      sample->evaluate(modelOf(s), w.data, nullptr, scenario_.actuators, w.v, w.a, false);
       for (std::size_t k = 0; k < which.size(); ++k)
         wrenches[static_cast<std::size_t>(which[k])].col(s) = sample->innerResult().wrenches.segment<6>(6 * (1 + static_cast<int>(k)));
       previous = std::move(sample);
@@ -432,10 +456,11 @@ void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bo
 void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w,
                                   SampleBlock& b) {
   const int n = jointCount_, contacts = outputs_.contacts;
+  const DynamicsModel& model = modelOf(s);  // with the ball before its release
   if (derivatives)
-    inverseDynamicsDerivatives(model_, w.data, w.derivatives, w.q, w.v, w.a);
+    inverseDynamicsDerivatives(model, w.data, w.derivatives, w.q, w.v, w.a);
   else
-    inverseDynamics(model_, w.data, w.q, w.v, w.a);
+    inverseDynamics(model, w.data, w.q, w.v, w.a);
   const DynamicsDerivatives& d = w.derivatives;
   b.velocity = w.v;
   b.acceleration = w.a;
@@ -445,7 +470,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
     // The inner problem picks the wrenches (formulation.md §7); Γ and its derivatives
     // through the KKT sensitivity (§8).
     BilevelSample& sample = *bilevelSamples_[static_cast<std::size_t>(s)];
-    sample.evaluate(model_, w.data, derivatives ? &d : nullptr, scenario_.actuators, w.v, w.a, derivatives);
+    sample.evaluate(model, w.data, derivatives ? &d : nullptr, scenario_.actuators, w.v, w.a, derivatives);
     w.torque = sample.torque();
     b.y[outputs_.infeasibility()] = sample.infeasibility();
     const Eigen::VectorXd& F = sample.innerResult().wrenches;
@@ -475,17 +500,17 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
       for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) F += t.weight * x.segment<6>(t.variable);
       b.wrenches.segment<6>(6 * (1 + i)) = F;
       const EnvironmentContact& contact = scenario_.contacts[static_cast<std::size_t>(i)];
-      const ContactFrame frame = contactFrame(model_, w.data, contact.surface.frame, contact.surface.placement);
+      const ContactFrame frame = contactFrame(model, w.data, contact.surface.frame, contact.surface.placement);
       WrenchToTorque& toTorque = w.toTorque[static_cast<std::size_t>(i)];
       Matrix6& toWorld = w.toWorld[static_cast<std::size_t>(i)];
-      wrenchToTorque(model_, w.data, frame, toTorque);
+      wrenchToTorque(model, w.data, frame, toTorque);
       wrenchToWorld(frame, toWorld);
       w.torque.noalias() -= toTorque * F;
       reference.noalias() -= toWorld * F;
       contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment<6>(outputs_.contactRow(i, 0)),
                                                         w.rowsByWrench[static_cast<std::size_t>(i)]);
       if (derivatives) {
-        wrenchMapDerivatives(model_, w.data, frame, F, w.dWorld, w.dTorque);
+        wrenchMapDerivatives(model, w.data, frame, F, w.dWorld, w.dTorque);
         w.torqueDq -= w.dTorque;
         w.referenceDq -= w.dWorld;
       }
@@ -593,10 +618,10 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
 double MotionProblem::objective(const Eigen::VectorXd& x) {
   evaluate(x, false);
   const int N = samples_.sampleCount(), n = jointCount_;
-  const double dt = duration(x) / (N - 1);
+  const double T = duration(x);
   double energy = 0.0;
   for (int s = 0; s < N; ++s) {
-    const double weight = (s == 0 || s == N - 1) ? 0.5 * dt : dt;
+    const double weight = sampleWeights_[static_cast<std::size_t>(s)] * T;
     double sum = 0.0;
     if (scenario_.energyForm == EnergyForm::Epigraph)
       sum = x.segment(slackIndex(s, 0), n).sum();
@@ -617,11 +642,11 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
   else if (scenario_.accelerationWeight > 0.0)
     evaluate(x, false);
   const int N = samples_.sampleCount(), n = jointCount_;
-  const double T = duration(x), dt = T / (N - 1);
+  const double T = duration(x);
   gradient.setZero(variableCount_);
   double dT = 0.0;
   for (int s = 0; s < N; ++s) {
-    const double weight = (s == 0 || s == N - 1) ? 0.5 * dt : dt;
+    const double weight = sampleWeights_[static_cast<std::size_t>(s)] * T;
     const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
     if (scenario_.accelerationWeight > 0.0) {
       // ∂q̈_j/∂x_{j,l} = w''_l / T², ∂q̈/∂T = −2 q̈ / T; the weight Δt ∝ T.
@@ -716,6 +741,36 @@ MotionProblem::Violations MotionProblem::violations(const Eigen::VectorXd& x) {
   return v;
 }
 
+std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) const {
+  if (!scenario_.ball) return std::nullopt;
+  const ThrownBall& ball = *scenario_.ball;
+  const auto landing = std::find_if(scenario_.tasks.begin(), scenario_.tasks.end(),
+                                    [](const TaskSpec& t) { return t.kind == TaskKind::ThrowLanding; });
+  const double T = duration(x);
+  const SampledTrajectory atRelease(parametrization_, std::vector<double>{sampleTimes_[static_cast<std::size_t>(releaseSample_)]});
+  Eigen::MatrixXd controlPoints;
+  parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
+  Eigen::VectorXd q(jointCount_), v(jointCount_), a(jointCount_);
+  atRelease.evaluate(0, controlPoints, T, q, v, a);
+  DynamicsData data(model_);
+  inverseDynamics(model_, data, q, v, a);  // the bodies' poses and twists
+  const RigidTransform pose = framePose(model_, data, ball.frame);
+  const auto body = static_cast<std::size_t>(model_.framePosition(ball.frame));
+  ReleaseState r;
+  r.time = atRelease.time(0, T);
+  r.position = pose.rotation * ball.point + pose.translation;
+  r.velocity = data.linearVelocity[body] + data.angularVelocity[body].cross(r.position);
+  const BallisticFlight f = ballisticFlight(r.position, r.velocity, landing->target.z(), landing->gravity);
+  r.flightTime = f.flightTime;
+  r.landing = Vector3(f.landing.x(), f.landing.y(), landing->target.z());
+  r.apexAboveTarget = f.apexAboveTarget;
+  r.speed = f.speed, r.elevation = f.elevation;
+  const Eigen::Vector2d offset = f.landing - landing->target.head<2>();
+  r.missDistance = offset.norm();
+  r.missOutsideBox = (offset.cwiseAbs() - landing->upper.head<2>()).cwiseMax(0.0).norm();
+  return r;
+}
+
 SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   evaluate(x, false);
   const int N = samples_.sampleCount(), n = jointCount_, contacts = outputs_.contacts;
@@ -737,9 +792,9 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
     const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
     p.time[s] = samples_.time(s, T);
     samples_.evaluate(s, controlPoints_, T, p.q.col(s), p.v.col(s), p.a.col(s));
-    inverseDynamics(model_, w.data, p.q.col(s), p.v.col(s), p.a.col(s));
+    inverseDynamics(modelOf(s), w.data, p.q.col(s), p.v.col(s), p.a.col(s));
     p.tau0.col(s) = w.data.tau;
-    p.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(model_, w.data);
+    p.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(modelOf(s), w.data);
     for (int j = 0; j < n; ++j) p.tau(j, s) = b.y[outputs_.torque(j)], p.power(j, s) = b.y[outputs_.power(j)];
     for (std::size_t c = 0; c < surfaces.size(); ++c) {
       const bool active = c == 0 || contactActive(static_cast<int>(c) - 1, s);
@@ -758,7 +813,9 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
     }
   }
   p.energy = positiveEnergy(p.power, p.time);
-  if (contacts == 0) {
+  p.release = release(x);
+  // The fine resampling knows one model: without a ball only (a thrown ball's samples carry it).
+  if (contacts == 0 && !scenario_.ball) {
     TrajectoryEvaluator evaluator(model_, scenario_.actuators, SampledTrajectory(parametrization_, scenario_.outputSamples));
     TrajectoryResult fineResult;
     evaluator.evaluate(x.head(parameterCount_), T, fineResult);

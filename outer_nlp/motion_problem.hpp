@@ -40,6 +40,7 @@
 #include <Eigen/Eigenvalues>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,19 @@ const char* constraintKindName(ConstraintKind kind);
 
 class BilevelSample;
 struct MotionWorkspace;  // outer_nlp/motion_workspace.hpp
+
+/// A thrown ball at its release (formulation.md §10), from the motion's q, q̇ at t_r by
+/// forward kinematics, and its flight to the target's height (ballistic_flight.hpp).
+struct ReleaseState {
+  double time = 0.0;                    ///< t_r [s]
+  Vector3 position = Vector3::Zero(), velocity = Vector3::Zero();  ///< of the ball, world frame
+  double flightTime = 0.0;              ///< τ [s] to the target's height
+  Vector3 landing = Vector3::Zero();    ///< where the flight crosses the target's height
+  double apexAboveTarget = 0.0;         ///< [m]; negative: the ball never reaches that height
+  double speed = 0.0, elevation = 0.0;  ///< [m/s], [rad]
+  double missDistance = 0.0;            ///< |landing − target| [m]
+  double missOutsideBox = 0.0;          ///< distance from the landing point to the target's box [m] (0 inside)
+};
 
 /// Everything a motion's samples say, for results (apps serialise it; nothing is re-evaluated there).
 struct SampledPhysics {
@@ -87,6 +101,8 @@ struct SampledPhysics {
   Eigen::VectorXd fineTime;
   Eigen::MatrixXd finePower;
   double fineEnergy = std::numeric_limits<double>::quiet_NaN();
+  /// With a throw: the release. The samples then hold t_r twice, loaded and released.
+  std::optional<ReleaseState> release;
 };
 
 class MotionProblem final : public NlpProblem {
@@ -163,6 +179,13 @@ class MotionProblem final : public NlpProblem {
     int worstRow = -1;  ///< -1 when a variable bound is the worst
   };
   Violations violations(const Eigen::VectorXd& x);
+
+  /// With a throw: the ball at its release at x (forward kinematics at t_r, no cached state).
+  std::optional<ReleaseState> release(const Eigen::VectorXd& x) const;
+  /// The NLP's samples: the scenario's N, and with a ball the release sample twice (loaded,
+  /// then released). Normalised times and trapezoid weights (fractions of T).
+  int sampleCount() const { return samples_.sampleCount(); }
+  bool sampleCarriesBall(int s) const { return loaded_[static_cast<std::size_t>(s)]; }
 
   /// The motion's physics at the samples (and closure drift at the scenario's output samples).
   SampledPhysics sampledPhysics(const Eigen::VectorXd& x);
@@ -242,11 +265,18 @@ class MotionProblem final : public NlpProblem {
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;
   int slackIndex(int sample, int joint) const { return slackStart_ + sample * jointCount_ + joint; }
+  /// The robot's dynamics at sample s: with the ball while it is carried.
+  const DynamicsModel& modelOf(int s) const { return loaded_[static_cast<std::size_t>(s)] ? *loadedModel_ : model_; }
 
   const Scenario& scenario_;
   DynamicsModel model_;
   MotionParametrization parametrization_;
   SampledTrajectory samples_;
+  std::vector<double> sampleTimes_;       ///< normalised, per NLP sample
+  std::vector<double> sampleWeights_;     ///< trapezoid weights, fractions of T
+  std::vector<bool> loaded_;              ///< per sample: the ball still in the hand
+  std::unique_ptr<DynamicsModel> loadedModel_;  ///< the robot with the ball (a throw)
+  int releaseSample_ = -1;                ///< the loaded twin of the release sample; releaseSample_ + 1 is released
   std::vector<int> taskOfInstant_;        ///< task index of each task instant
   SampledTrajectory taskSamples_;         ///< the task instants, as normalised times
   int jointCount_ = 0, parameterCount_ = 0, variableCount_ = 0, slackStart_ = 0, forceStart_ = 0;

@@ -79,7 +79,7 @@ TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, con
   const auto k = kinds.find(kind);
   if (k == kinds.end())
     throw InputError(where(file, kindNode, field + ".kind") + "unknown task kind '" + kind +
-                     "' (expected position, orientation, linear_velocity, angular_velocity, center_of_mass)");
+                     "' (expected position, orientation, linear_velocity, angular_velocity, center_of_mass, throw)");
   t.kind = k->second;
 
   if (t.kind == TaskKind::CenterOfMass) {
@@ -458,11 +458,20 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
     if (l["minimum_normal_force"])
       s.minimumNormalForce = yaml::nonNegative(file, l["minimum_normal_force"], "limits.minimum_normal_force");
   }
+  YAML::Node throwNode;  // the throw task, checked against the whole scenario at the end
+  std::string throwField;
   if (root["tasks"]) {
     const YAML::Node tasks = root["tasks"];
     if (!tasks.IsSequence()) throw InputError(where(file, tasks, "tasks") + "expected a list of tasks");
-    for (std::size_t i = 0; i < tasks.size(); ++i)
-      s.tasks.push_back(readTask(file, tasks[i], "tasks[" + std::to_string(i) + "]", s.robot, s.duration.initial));
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      const std::string field = "tasks[" + std::to_string(i) + "]";
+      if (tasks[i].IsMap() && tasks[i]["kind"] && tasks[i]["kind"].IsScalar() && tasks[i]["kind"].Scalar() == "throw") {
+        readThrowTask(file, tasks[i], field, s);
+        throwNode = tasks[i], throwField = field;
+      } else {
+        s.tasks.push_back(readTask(file, tasks[i], field, s.robot, s.duration.initial));
+      }
+    }
   }
 
   const YAML::Node startNode = yaml::required(file, root, "start", "");
@@ -555,6 +564,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
   }
 
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
+  if (s.ball) checkThrowTask(file, throwNode, throwField, s);
   return s;
 }
 

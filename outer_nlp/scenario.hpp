@@ -8,6 +8,7 @@
 #include <array>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,7 +25,12 @@ enum class EnergyForm {
   Epigraph,       ///< slack s ≥ P, s ≥ 0 per joint and sample; minimise the trapezoid sum of s
 };
 
-enum class TaskKind { Position, Orientation, LinearVelocity, AngularVelocity, CenterOfMass };
+/// ThrowLanding and ThrowRelease are the two halves of a `throw` task (formulation.md §10;
+/// outer_nlp/ballistic_flight.hpp), both at the release instant on the ball's point:
+///   ThrowLanding  (L_x − target_x, L_y − target_y, τ): the landing point at the target's
+///                 height relative to the target, and the flight time;
+///   ThrowRelease  (|v|, elevation of v [rad], apex height above the target [m]).
+enum class TaskKind { Position, Orientation, LinearVelocity, AngularVelocity, CenterOfMass, ThrowLanding, ThrowRelease };
 
 /// Bounds on a 3-vector task quantity; ±∞ where a component is free.
 struct TaskSpec {
@@ -36,10 +42,23 @@ struct TaskSpec {
   int frame = -1;            ///< RobotModel frame of `body`
   Vector3 point = Vector3::Zero();       ///< in the body frame (position, linear velocity)
   Matrix3 targetRotation = Matrix3::Identity();  ///< orientation tasks: the error is measured from it
+  Vector3 target = Vector3::Zero();      ///< throw tasks: the target point, world frame [m]
+  double gravity = 9.81;                 ///< throw tasks: gravity's magnitude (along −z) [m/s²]
   double start = 0.0, end = 0.0;         ///< instant (start == end) or window [s], of the initial duration
   bool window = false;
   Eigen::Vector3d lower = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
   Eigen::Vector3d upper = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+};
+
+/// The ball of a `throw` task (formulation.md §10): a point mass carried by a body until its
+/// release, when its weight and inertial force stop loading that body.
+struct ThrownBall {
+  std::string origin;          ///< "file:line" of the throw task, for messages
+  std::string body;            ///< URDF link that holds it
+  int frame = -1;              ///< RobotModel frame of `body`
+  Vector3 point = Vector3::Zero();  ///< the ball's centre in that frame [m]
+  double mass = 0.0;           ///< [kg]
+  double releaseTime = 0.0;    ///< t_r [s] of the initial duration; a sample (a fraction of a free duration)
 };
 
 /// How the contact wrenches enter the outer problem (formulation.md §9).
@@ -138,6 +157,8 @@ struct Scenario {
   /// again (docs/scenarios.md, "Torque-limit screening"). 0: every row in the NLP.
   double torqueScreening = 0.5;
   std::vector<TaskSpec> tasks;
+  /// A throw task's ball (at most one throw a scenario); its two rows are in `tasks`.
+  std::optional<ThrownBall> ball;
 
   Eigen::VectorXd start, end;      ///< initial guesses for the start and end postures [rad]
   bool fixStart = false, fixEnd = false;

@@ -7,10 +7,19 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <string>
 
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt {
+
+/// The `throw` task (formulation.md §10; docs/scenarios.md, "Throw"; outer_nlp/throw_task.cpp):
+/// `node` is tasks[i] with `kind: throw`; appends its two rows (TaskKind::ThrowLanding,
+/// ThrowRelease) to s.tasks and sets s.ball. Needs the robot, the duration and the gravity read.
+void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, Scenario& s);
+/// What only the whole scenario decides: the release on a sample of the motion (and of every
+/// continuation stage's grid), and the ball on a body that is not a contact's.
+void checkThrowTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, const Scenario& s);
 
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.

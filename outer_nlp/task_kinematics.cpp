@@ -1,6 +1,7 @@
 #include "outer_nlp/task_kinematics.hpp"
 
 #include "core/spatial.hpp"
+#include "outer_nlp/ballistic_flight.hpp"
 
 namespace mcopt {
 
@@ -9,6 +10,34 @@ namespace {
 /// va(M) = ½ vee(M − Mᵀ).
 Vector3 antisymmetricPart(const Matrix3& m) {
   return 0.5 * Vector3(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1));
+}
+
+/// The ball's flight from the point's position and velocity (formulation.md §10): the
+/// quantities of ballistic_flight.hpp, chained through ∂p/∂q = J_lin, ∂v_p/∂q (as for a linear
+/// velocity task) and ∂v_p/∂q̇ = J_lin.
+void evaluateThrow(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task, int position,
+                   const Vector3& point, const Vector3& omega, bool derivatives, TaskWorkspace& w, Vector3& value,
+                   Eigen::Ref<Eigen::Matrix3Xd> dq, Eigen::Ref<Eigen::Matrix3Xd> dv) {
+  const Vector3 velocity = data.linearVelocity[static_cast<std::size_t>(position)] + omega.cross(point);
+  const BallisticFlight f = ballisticFlight(point, velocity, task.target.z(), task.gravity);
+  Eigen::Matrix<double, 3, 6> gradient;  // of the three components in (p, v)
+  if (task.kind == TaskKind::ThrowLanding) {
+    value << f.landing.x() - task.target.x(), f.landing.y() - task.target.y(), f.flightTime;
+    gradient << f.landingGradient, f.flightTimeGradient;
+  } else {
+    value << f.speed, f.elevation, f.apexAboveTarget;
+    gradient << f.speedGradient, f.elevationGradient, f.apexGradient;
+  }
+  if (!derivatives) return;
+  frameJacobian(model, data, position, point, w.jacobian);
+  bodyMotionDerivatives(model, data, position, w.dTwistDq, w.dTwistDv, w.dAccelerationDq, w.dAccelerationDv,
+                        w.dAccelerationDa);
+  w.velocityDq = w.dTwistDq.topRows<3>();
+  w.velocityDq.noalias() -= skew(point) * w.dTwistDq.bottomRows<3>();
+  w.velocityDq.noalias() += skew(omega) * w.jacobian.topRows<3>();
+  dq.noalias() = gradient.leftCols<3>() * w.jacobian.topRows<3>();
+  dq.noalias() += gradient.rightCols<3>() * w.velocityDq;
+  dv.noalias() = gradient.rightCols<3>() * w.jacobian.topRows<3>();
 }
 
 }  // namespace
@@ -20,7 +49,8 @@ TaskWorkspace::TaskWorkspace(const DynamicsModel& model)
       dAccelerationDq(6, model.jointCount()),
       dAccelerationDv(6, model.jointCount()),
       dAccelerationDa(6, model.jointCount()),
-      comJacobian(3, model.jointCount()) {}
+      comJacobian(3, model.jointCount()),
+      velocityDq(3, model.jointCount()) {}
 
 void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task, bool derivatives,
                   TaskWorkspace& w, Vector3& value, Eigen::Ref<Eigen::Matrix3Xd> dq, Eigen::Ref<Eigen::Matrix3Xd> dv) {
@@ -37,6 +67,10 @@ void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const Ta
   const RigidTransform pose = framePose(model, data, task.frame);
   const Vector3 point = pose.rotation * task.point + pose.translation;
   const Vector3& omega = data.angularVelocity[static_cast<std::size_t>(position)];
+  if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease) {
+    evaluateThrow(model, data, task, position, point, omega, derivatives, w, value, dq, dv);
+    return;
+  }
   switch (task.kind) {
     case TaskKind::Position: value = point; break;
     case TaskKind::Orientation: value = antisymmetricPart(task.targetRotation.transpose() * pose.rotation); break;
@@ -44,7 +78,7 @@ void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const Ta
       value = data.linearVelocity[static_cast<std::size_t>(position)] + omega.cross(point);
       break;
     case TaskKind::AngularVelocity: value = omega; break;
-    case TaskKind::CenterOfMass: break;
+    default: break;
   }
   if (!derivatives) return;
   frameJacobian(model, data, position, point, w.jacobian);
@@ -75,7 +109,7 @@ void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const Ta
       dq = w.dTwistDq.bottomRows<3>();
       dv = w.jacobian.bottomRows<3>();
       break;
-    case TaskKind::CenterOfMass: break;
+    default: break;
   }
 }
 

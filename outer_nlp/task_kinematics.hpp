@@ -6,6 +6,8 @@
 //   linear velocity of the point             v_p = v_O + ω × p
 //   angular velocity of the body             ω
 //   centre of mass                           c,  ∂c/∂q = J_com
+//   throw (landing, release)                 functions of the point's p and v_p
+//                                            (outer_nlp/ballistic_flight.hpp), chained
 // A change δθ = J_ang δq of the body's world orientation gives δe = va(Rtᵀ [δθ]× R) with
 // va(M) = ½ vee(M − Mᵀ); ∂v_p/∂q = ∂v_O/∂q − [p]× ∂ω/∂q + [ω]× J_lin (twist derivatives:
 // core/motion_derivatives.hpp).
@@ -25,7 +27,14 @@ struct TaskWorkspace {
   FrameJacobian jacobian;
   MotionDerivative dTwistDq, dTwistDv, dAccelerationDq, dAccelerationDv, dAccelerationDa;
   Eigen::Matrix3Xd comJacobian;
+  Eigen::Matrix3Xd velocityDq;  ///< ∂v_p/∂q of a throw's ball
 };
+
+/// Whether the task's quantity depends on q̇ (else on q alone).
+inline bool taskReadsVelocity(TaskKind kind) {
+  return kind == TaskKind::LinearVelocity || kind == TaskKind::AngularVelocity || kind == TaskKind::ThrowLanding ||
+         kind == TaskKind::ThrowRelease;
+}
 
 /// value: the task quantity; dq, dv: 3 × jointCount, written when `derivatives` is set.
 void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task, bool derivatives,

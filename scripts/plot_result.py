@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Figures of one optimised motion (docs/plots.md), from the result folder `mcopt run` wrote:
 joint positions and torques within their limits, contact wrenches and friction-cone margins,
-centres of pressure inside their rectangles, power per joint and cumulative energy, and
-Ipopt's convergence. Called by `mcopt plot`; needs matplotlib (Debian's python3-matplotlib).
+centres of pressure inside their rectangles, power per joint and cumulative energy,
+Ipopt's convergence, and a throw's ball flight to its target. Called by `mcopt plot`; needs matplotlib (Debian's python3-matplotlib).
 
     plot_result.py RESULT_DIR OUT_DIR    writes OUT_DIR/<figure>.png and .svg, one path a line
 """
@@ -170,6 +170,38 @@ def convergence_figure(result, out, written):
     save(fig, out, "convergence", written)
 
 
+def throw_figure(result, out, written):
+    """A throw's ball from its release to the target's height: side (x–z) and top (x–y)
+    views of p + v τ + ½ g τ², with the target (and its box) and the landing point."""
+    release = result.get("release")
+    if not release:
+        return
+    p, v, g = release["position"], release["velocity"], result.get("gravity", [0.0, 0.0, -9.81])
+    tau = release["flight_time"]
+    steps = 100
+    flight = [[p[i] + v[i] * t + 0.5 * g[i] * t * t for i in range(3)] for t in (tau * k / steps for k in range(steps + 1))]
+    target, half = release["target"], release["target_half_widths_m"]
+    landing = release["landing_point"]
+    fig, (side, top) = plt.subplots(1, 2, figsize=(12, 4.5))
+    for ax, (a, b), labels in ((side, (0, 2), ("x [m]", "z [m]")), (top, (0, 1), ("x [m]", "y [m]"))):
+        ax.plot([f[a] for f in flight], [f[b] for f in flight], color="tab:blue", label="ball's flight")
+        ax.plot([p[a]], [p[b]], "o", color="tab:blue", label=f"release at t = {release['time']:.3f} s")
+        ax.plot([target[a]], [target[b]], "x", color="tab:red", markersize=10, label="target")
+        ax.plot([landing[a]], [landing[b]], "+", color="black", markersize=12, label="landing point")
+        ax.set_xlabel(labels[0])
+        ax.set_ylabel(labels[1])
+        ax.set_aspect("equal", adjustable="datalim")
+    if half[0] > 0 or half[1] > 0:
+        top.add_patch(plt.Rectangle((target[0] - half[0], target[1] - half[1]), 2 * half[0], 2 * half[1], fill=False,
+                                    edgecolor="tab:red", linestyle="--", label="target box"))
+    side.axhline(target[2], color="gray", linewidth=0.8)
+    side.set_title(f"side view: {release['speed_m_s']:.2f} m/s at {release['elevation_deg']:.1f}°, "
+                   f"flight {tau:.3f} s")
+    top.set_title(f"top view: miss {release['miss_distance_m']:.2e} m")
+    top.legend(fontsize="small")
+    save(fig, out, "throw", written)
+
+
 def main(argv):
     if len(argv) != 3:
         print("usage: plot_result.py RESULT_DIR OUT_DIR", file=sys.stderr)
@@ -193,6 +225,7 @@ def main(argv):
         contact_figures(result, argv[2], written)
         energy_line = power_figure(result, argv[2], written)
         convergence_figure(result, argv[2], written)
+        throw_figure(result, argv[2], written)
     except BadResult as e:
         print(f"{source}: {e}", file=sys.stderr)
         return 2

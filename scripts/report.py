@@ -137,6 +137,9 @@ def optimisations(mcopt, source, work, quick, time_limit):
             label = f"{name}/{forces}" + (f"/{solver}" if solver else "")
             arguments = ["--contact-forces", forces] + (["--inner-solver", solver] if solver else []) + extra
             runs[label] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / label.replace("/", "-"), arguments, time_limit)
+    # The throws (docs/scenarios.md, "Throw"), each as bundled; --quick: the double-support one.
+    for name in ("throw",) if quick else ("throw", "throw_one_foot", "throw_hand_support", "throw_free_release"):
+        runs[name] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / name, extra, time_limit)
     return runs
 
 

@@ -12,7 +12,9 @@
   const scene = JSON.parse(document.getElementById('mcopt-scene').textContent);
   const FORCE_SCALE = 1 / 1000;  // m per N, as the legend says
   const times = scene.time;
-  const duration = times[times.length - 1];
+  // The timeline covers the motion and, for a throw, the ball's flight to the target's height
+  // (the robot at rest in its last pose meanwhile).
+  const duration = Math.max(times[times.length - 1], scene.ball ? scene.ball.release_time + scene.ball.flight_time : 0);
 
   // Z up, as the robot's world frame.
   THREE.Object3D.DefaultUp.set(0, 0, 1);
@@ -95,6 +97,26 @@
   drawnOnTop(com);
   world.add(com);
 
+  // A throw's ball: in the hand up to the release, then on its flight p + v τ + ½ g τ² to the
+  // target's height, where it stays; its path and the target drawn throughout.
+  const ball = scene.ball;
+  let ballMesh = null;
+  if (ball) {
+    ballMesh = new THREE.Mesh(new THREE.SphereGeometry(0.035, 20, 14), material([0.95, 0.55, 0.1, 1]));
+    world.add(ballMesh);
+    const path = [];
+    for (let i = 0; i <= 60; i += 1) path.push(new THREE.Vector3(...ballInFlight(ball.flight_time * i / 60)));
+    world.add(new THREE.Line(new THREE.BufferGeometry().setFromPoints(path),
+                             new THREE.LineDashedMaterial({ color: 0xe08020, dashSize: 0.05, gapSize: 0.03 })).computeLineDistances());
+    const target = new THREE.Mesh(new THREE.RingGeometry(0.04, 0.07, 32), new THREE.MeshBasicMaterial({ color: 0xd02020, side: THREE.DoubleSide }));
+    target.position.set(...ball.target);
+    target.position.z += 0.002;
+    world.add(target);
+  }
+  function ballInFlight(tau) {
+    return [0, 1, 2].map((i) => ball.position[i] + ball.velocity[i] * tau + 0.5 * scene.gravity[i] * tau * tau);
+  }
+
   const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 100);
   const controls = new THREE.OrbitControls(camera, renderer.domElement);
   {
@@ -146,6 +168,11 @@
     });
     const c = lerp3(scene.center_of_mass[k0], scene.center_of_mass[k1], w);
     com.position.set(c[0], c[1], c[2]);
+    if (ball) {
+      const p = t < ball.release_time ? lerp3(ball.carried[k0], ball.carried[k1], w)
+                                      : ballInFlight(Math.min(t - ball.release_time, ball.flight_time));
+      ballMesh.position.set(p[0], p[1], p[2]);
+    }
   }
 
   // Playback.
@@ -203,6 +230,7 @@
       state.bodies[group.name] = {
         position: position.toArray(), quaternion_xyzw: orientation.toArray(), shape_centre: centre.toArray() };
     });
+    if (ballMesh) state.ball = ballMesh.position.toArray();
     document.getElementById('mcopt-state').textContent = JSON.stringify(state);
   }
 

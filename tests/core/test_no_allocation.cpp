@@ -323,15 +323,16 @@ TEST_CASE("the sensitivity of degenerate samples allocates nothing once warm: we
   CHECK(singular >= 3);
 }
 
-TEST_CASE("the outer problem's evaluation allocates nothing once warm: one contact and each multi-contact formulation",
+TEST_CASE("the outer problem's evaluation allocates nothing once warm: one contact, each multi-contact formulation, a throw",
           "[outer][allocation]") {
   // What Ipopt calls per iterate: objective, gradient, constraints, Jacobian values, Hessian.
-  // Each per-sample Hessian option: the differences and the Gauss–Newton model.
-  for (const char* file : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml"})
+  // Each per-sample Hessian option: the differences and the Gauss–Newton model. The throw:
+  // its rows and the ball's two models (21 samples keep its release on a sample).
+  for (const char* file : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml", "hrp2_throw.yaml"})
     for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables})
     for (const HessianOption option : {HessianOption::SampleDifferences, HessianOption::GaussNewton}) {
       Scenario scenario = loadScenario(test::sourceDir() / "scenarios" / file);
-      scenario.samples = 20;
+      scenario.samples = scenario.ball ? 21 : 20;
       scenario.contactForces = forces;
       scenario.hessian = option;
       MotionProblem problem(scenario);

@@ -202,3 +202,36 @@ def test_results_it_cannot_draw_are_refused_with_the_field(mcopt_exe, replayed, 
     (tmp_path / "empty").mkdir()
     assert cli_error(mcopt_exe, "replay", tmp_path / "empty") == \
         f"{tmp_path / 'empty' / 'result.json'}: file not found (give the folder `mcopt run --out` wrote)"
+
+
+def test_a_throw_shows_the_ball_in_the_hand_then_on_its_flight(mcopt_exe, tmp_path):
+    """The throw's ball (issue 15): where our kinematics puts the hand's point before the
+    release, on the flight result.json's release state gives after it, drawn there, and
+    resting at the landing point at the end."""
+    s = mcopt.Scenario(SOURCE / "scenarios" / "hrp2_throw.yaml")
+    s.save(tmp_path / "throw.yaml")
+    run_cli(mcopt_exe, "run", tmp_path / "throw.yaml", "--max-iterations", 4, "--out", tmp_path / "throw", check=False)
+    run_cli(mcopt_exe, "replay", tmp_path / "throw", "--out", tmp_path / "throw.html")
+    result = json.loads((tmp_path / "throw" / "result.json").read_text())
+    release = result["release"]
+    dynamics = kinematics(result)
+    k = 10  # t = 0.4 s, the ball in the hand
+    state, image, console = open_page(tmp_path / "throw.html", f"#t={result['time'][k]!r}", tmp_path, "carried")
+    assert console == [] and state["errors"] == []
+    position, rotation = dynamics.frame_pose(release["body"], np.array(result["q"][k]))
+    # The scene keeps positions to 1e-5 m (apps/replay_scene.cpp), as the bodies' (atol 2e-5 above).
+    assert np.allclose(state["ball"], position + rotation @ np.array(release["point"]), atol=2e-5)
+    pixel = projector(state["camera"], image.shape[1], image.shape[0] - 56)
+    assert drawn_at(image, pixel(np.array(state["ball"])))
+    g = np.array(result["gravity"])
+    for tag, tau in (("flying", 0.5 * release["flight_time"]), ("landed", release["flight_time"])):
+        t = release["time"] + tau
+        state, image, console = open_page(tmp_path / "throw.html", f"#t={t!r}", tmp_path, tag)
+        assert console == [] and state["errors"] == []
+        expected = np.array(release["position"]) + np.array(release["velocity"]) * tau + 0.5 * g * tau * tau
+        assert np.allclose(state["ball"], expected, atol=2e-5), f"{tag}: ball at {state['ball']}, flies through {expected}"
+        pixel = projector(state["camera"], image.shape[1], image.shape[0] - 56)
+        xy = pixel(expected)
+        if 0 < xy[0] < image.shape[1] and 0 < xy[1] < image.shape[0] - 56:
+            assert drawn_at(image, xy), f"{tag}: nothing drawn at the ball"
+    assert np.allclose(expected, release["landing_point"], atol=1e-6)

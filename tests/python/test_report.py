@@ -47,7 +47,7 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
     runs = report["optimisations"]
     expected = {"kick/configuration-on", "kick/configuration-off", "lean_reach/bilevel/active-set"}
     expected |= {f"weight_shift/bilevel/{s}" for s in ("active-set", "slsqp", "ipopt")}
-    expected |= {"weight_shift/splines", "weight_shift/variables"}
+    expected |= {"weight_shift/splines", "weight_shift/variables", "throw"}
     assert set(runs) == expected
     for label, run in runs.items():
         # --max-iterations 1 bounds each continuation stage (the multi-contact scenarios have two).

@@ -1,0 +1,171 @@
+// `mcopt run` on a throw (issue 15, docs/scenarios.md "Throw"): the bundled throw ends optimal
+// and its ball, computed here from the result's own q and q̇ at the release by forward
+// kinematics (not the optimiser's rows), lands within 1 mm of the target, and `mcopt plot`
+// draws its flight; every class of bad throw is refused with file, line and field.
+#include <yaml-cpp/yaml.h>
+
+#include <catch2/catch.hpp>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "common/run_command.hpp"
+#include "common/scenario_variant.hpp"
+#include "common/temp_dir.hpp"
+#include "common/test_support.hpp"
+#include "core/dynamics_model.hpp"
+#include "core/inverse_dynamics.hpp"
+#include "core/kinematics.hpp"
+#include "core/robot_model.hpp"
+
+using namespace mcopt;
+using Catch::Matchers::Contains;
+using Json = nlohmann::json;
+
+namespace {
+
+const std::filesystem::path kThrow = test::sourceDir() / "scenarios/hrp2_throw.yaml";
+
+#ifdef MCOPT_UNDER_SANITIZERS
+constexpr bool kUnderSanitizers = true;
+#else
+constexpr bool kUnderSanitizers = false;
+#endif
+
+Json readJson(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  return Json::parse(in);
+}
+
+Eigen::VectorXd row(const Json& matrix, std::size_t k) {
+  const std::vector<double> v = matrix.at(k).get<std::vector<double>>();
+  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+}
+
+}  // namespace
+
+TEST_CASE("throw: the bundled throw ends optimal and its ball lands on the target, by forward kinematics of its q and q̇",
+          "[cli][run][throw]") {
+  const test::TempDir dir;
+  // Under the sanitizers a few iterations: the release block and its fields; Release runs to the optimum.
+  const auto r = test::runMcopt("run " + test::quoted(kThrow) + " --out " + test::quoted(dir.path() / "out") +
+                                (kUnderSanitizers ? " --max-iterations 3" : ""));
+  INFO(r.all());
+  CHECK_THAT(r.output, Contains("miss [m]"));
+  const Json result = readJson(dir.path() / "out/result.json");
+  const Json& release = result.at("release");
+  const YAML::Node task = YAML::LoadFile(kThrow.string())["tasks"][0];
+  const double releaseTime = task["time"].as<double>();
+  const Eigen::Vector3d point(task["point"][0].as<double>(), task["point"][1].as<double>(), task["point"][2].as<double>());
+  const Eigen::Vector3d target(task["target"][0].as<double>(), task["target"][1].as<double>(), task["target"][2].as<double>());
+  CHECK(release.at("time").get<double>() == Approx(releaseTime));
+
+  // The release sample, twice in the time series (loaded, then released): the same state.
+  const std::vector<double> time = result.at("time").get<std::vector<double>>();
+  std::size_t k = 0;
+  while (k < time.size() && std::abs(time[k] - releaseTime) > 1e-12) ++k;
+  REQUIRE(k + 1 < time.size());
+  CHECK(time[k + 1] == time[k]);
+  const Eigen::VectorXd q = row(result.at("q"), k), v = row(result.at("v"), k);
+  CHECK(q == row(result.at("q"), k + 1));
+
+  // The ball's position by forward kinematics, its velocity by central differences of it along q̇.
+  const RobotModel robot = loadUrdfFile(result.at("robot_files").at("urdf").get<std::string>());
+  REQUIRE(result.at("reference_pose").at("position").get<std::vector<double>>() == std::vector<double>{0.0, 0.0, 0.0});
+  const DynamicsModel model(robot, result.at("reference_body").get<std::string>());
+  const int frame = robot.frameIndex(task["body"].as<std::string>());
+  auto ballAt = [&](const Eigen::VectorXd& configuration) {
+    DynamicsData data(model);
+    forwardKinematics(model, data, configuration);
+    const RigidTransform pose = framePose(model, data, frame);
+    return Eigen::Vector3d(pose.rotation * point + pose.translation);
+  };
+  const double h = 1e-6;
+  const Eigen::Vector3d p = ballAt(q), velocity = (ballAt(q + h * v) - ballAt(q - h * v)) / (2 * h);
+  // Its flight to the target's height: z(τ) = p_z + v_z τ − ½ g τ² = target_z, descending.
+  const double g = 9.81;
+  const double tau = (velocity.z() + std::sqrt(velocity.z() * velocity.z() + 2 * g * (p.z() - target.z()))) / g;
+  const Eigen::Vector2d landing = p.head<2>() + velocity.head<2>() * tau;
+  const double miss = (landing - target.head<2>()).norm();
+  INFO("ball at " << p.transpose() << ", velocity " << velocity.transpose() << ", lands at " << landing.transpose()
+                  << " after " << tau << " s: miss " << miss << " m");
+  CHECK((p - row(Json::array({release.at("position")}), 0)).norm() < 1e-9);
+  CHECK(std::abs(release.at("miss_distance_m").get<double>() - miss) < 1e-6);
+  CHECK(std::abs(release.at("flight_time").get<double>() - tau) < 1e-6);
+  // Its figures: the ball's flight among them, and the energy curve ending at result.json's
+  // energy over the samples (t_r twice: each side of the release its half interval).
+  const auto plot = test::runMcopt("plot " + test::quoted(dir.path() / "out"));
+  INFO(plot.all());
+  REQUIRE(plot.exitCode == 0);
+  for (const char* extension : {".png", ".svg"}) {
+    const auto file = dir.path() / "out/plots" / (std::string("throw") + extension);
+    REQUIRE(std::filesystem::exists(file));
+    CHECK(std::filesystem::file_size(file) > 5000);
+  }
+  CHECK_THAT(plot.output, Contains("result.json energy "));
+  if (kUnderSanitizers) return;
+  CHECK(r.exitCode == 0);
+  CHECK(result.at("status") == "optimal");
+  CHECK(result.at("max_violation").get<double>() <= 1e-6);
+  CHECK(miss <= 1e-3);
+}
+
+TEST_CASE("throw: every class of bad throw is refused with file, line and field", "[cli][run][throw]") {
+  const test::TempDir dir;
+  struct Case {
+    const char* what;
+    std::function<void(YAML::Node&)> edit;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases = {
+      {"release after the motion", [](YAML::Node& r) { r["tasks"][0]["time"] = 2.5; },
+       {"tasks[0].time: the release must be inside the motion"}},
+      {"release at the start", [](YAML::Node& r) { r["tasks"][0]["time"] = 0.0; },
+       {"tasks[0].time: the release must be inside the motion"}},
+      {"release between samples", [](YAML::Node& r) { r["tasks"][0]["time"] = 1.21; },
+       {"tasks[0].time: the release t_r = 1.21 s is not a sample of the 51-sample grid", "nearest 1.2 s"}},
+      {"release between a continuation stage's samples", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{samples: 26}]");
+         r["tasks"][0]["time"] = 1.24;
+       }, {"tasks[0].time: the release t_r = 1.24 s is not a sample of the 26-sample grid"}},
+      {"ball on a contact's body", [](YAML::Node& r) { r["tasks"][0]["body"] = "r_sole"; },
+       {"tasks[0].body: the ball would be on the body of contact 'r_sole'"}},
+      {"ball on the reference body", [](YAML::Node& r) { r["tasks"][0]["body"] = "l_sole"; },
+       {"tasks[0].body: the ball would be on the body of contact 'l_sole' (the reference body)"}},
+      {"ball on an unknown body", [](YAML::Node& r) { r["tasks"][0]["body"] = "r_claw"; },
+       {"tasks[0].body: unknown body 'r_claw'"}},
+      {"ball without mass", [](YAML::Node& r) { r["tasks"][0]["ball_mass"] = 0.0; },
+       {"tasks[0].ball_mass: must be positive"}},
+      {"negative ball mass", [](YAML::Node& r) { r["tasks"][0]["ball_mass"] = -0.2; },
+       {"tasks[0].ball_mass: must be positive"}},
+      {"speed bounds reversed", [](YAML::Node& r) { r["tasks"][0]["speed"] = YAML::Load("[5.0, 3.0]"); },
+       {"tasks[0].speed: the lower bound is above the upper bound"}},
+      {"elevation bounds reversed", [](YAML::Node& r) { r["tasks"][0]["elevation"] = YAML::Load("[60, 20]"); },
+       {"tasks[0].elevation: the lower bound is above the upper bound"}},
+      {"elevation beyond the vertical", [](YAML::Node& r) { r["tasks"][0]["elevation"] = YAML::Load("[95, null]"); },
+       {"tasks[0].elevation: an elevation lies in [−90°, 90°]"}},
+      {"flight in the past", [](YAML::Node& r) { r["tasks"][0]["flight_time"] = YAML::Load("[null, -0.1]"); },
+       {"tasks[0].flight_time: a flight takes a positive time"}},
+      {"negative target box", [](YAML::Node& r) { r["tasks"][0]["tolerance"] = -0.1; },
+       {"tasks[0].tolerance: must not be negative"}},
+      {"two throws", [](YAML::Node& r) { r["tasks"].push_back(YAML::Clone(r["tasks"][0])); },
+       {"tasks[1]: a scenario has one throw"}},
+      {"throw without gravity along -z", [](YAML::Node& r) { r["gravity"] = YAML::Load("[1.0, 0.0, -9.81]"); },
+       {"tasks[0]: a throw needs gravity along −z"}},
+      {"unknown throw field", [](YAML::Node& r) { r["tasks"][0]["spin"] = 3.0; }, {"tasks[0].spin: unknown key"}},
+      {"throw without target", [](YAML::Node& r) { r["tasks"][0].remove("target"); }, {"target", "missing required field"}},
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    if (kUnderSanitizers && i % 3 != 0) continue;  // every third class; the Release build runs all
+    const Case& c = cases[i];
+    const auto file = test::scenarioVariant(kThrow, dir, c.edit, "bad.yaml");
+    const auto r = test::runMcopt("run " + test::quoted(file) + " --out " + test::quoted(dir.path() / "never"));
+    INFO(c.what << ": " << r.all());
+    CHECK(r.exitCode == 2);
+    const auto at = r.errors.find(file.string() + ":");
+    REQUIRE(at != std::string::npos);
+    CHECK(std::isdigit(static_cast<unsigned char>(r.errors[at + file.string().size() + 1])));
+    for (const std::string& fragment : c.expected) CHECK_THAT(r.errors, Contains(fragment));
+    CHECK_FALSE(std::filesystem::exists(dir.path() / "never" / "result.json"));
+  }
+}
