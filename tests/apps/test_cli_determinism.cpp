@@ -18,12 +18,7 @@ using Json = nlohmann::json;
 
 namespace {
 
-// Under AddressSanitizer the executable runs ~10× slower: smaller problems, the same checks.
-#ifdef MCOPT_UNDER_SANITIZERS
-constexpr bool kUnderSanitizers = true;
-#else
-constexpr bool kUnderSanitizers = false;
-#endif
+using mcopt::test::kUnderSanitizers;
 
 std::string readText(const std::filesystem::path& file) {
   std::ifstream in(file, std::ios::binary);

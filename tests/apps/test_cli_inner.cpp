@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/random_inner_problem.hpp"
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/temp_dir.hpp"
 #include "inner_qp/inner_solver.hpp"
@@ -36,10 +37,7 @@ Json problemToJson(const test::RandomProblem& r) {
   return p;
 }
 
-Json readJson(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  return Json::parse(in);
-}
+using mcopt::test::readJson;
 
 }  // namespace
 

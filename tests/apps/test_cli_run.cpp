@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/scenario_variant.hpp"
 #include "common/temp_dir.hpp"
@@ -22,12 +23,7 @@ namespace {
 
 const std::filesystem::path kKick = test::sourceDir() / "scenarios/hrp2_kick.yaml";
 
-// Under AddressSanitizer the executable runs ~10× slower: lighter variants of the same checks.
-#ifdef MCOPT_UNDER_SANITIZERS
-constexpr bool kUnderSanitizers = true;
-#else
-constexpr bool kUnderSanitizers = false;
-#endif
+using mcopt::test::kUnderSanitizers;
 
 /// A bundled scenario with its side files made absolute, then `edit` applied, written to dir.
 using test::scenarioVariant;
@@ -48,10 +44,7 @@ int exitStatusEchoed(const std::string& command) {
   return std::stoi(echoed);
 }
 
-Json readJson(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return Json::parse(in);
-}
+using mcopt::test::readJson;
 
 }  // namespace
 

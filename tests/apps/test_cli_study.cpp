@@ -23,11 +23,7 @@ using Json = nlohmann::json;
 
 namespace {
 
-#ifdef MCOPT_UNDER_SANITIZERS
-constexpr bool kUnderSanitizers = true;
-#else
-constexpr bool kUnderSanitizers = false;
-#endif
+using mcopt::test::kUnderSanitizers;
 
 /// Four cases of the kick at 10 samples: two stopped at 15 iterations (≈ 0.5 s), two at 100
 /// (≈ 3 s), so that a test can stop the study while only the last two run.

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "common/json_file.hpp"
 #include "common/run_command.hpp"
 #include "common/scenario_variant.hpp"
 #include "common/temp_dir.hpp"
@@ -26,16 +27,9 @@ namespace {
 
 const std::filesystem::path kThrow = test::sourceDir() / "scenarios/hrp2_throw.yaml";
 
-#ifdef MCOPT_UNDER_SANITIZERS
-constexpr bool kUnderSanitizers = true;
-#else
-constexpr bool kUnderSanitizers = false;
-#endif
+using mcopt::test::kUnderSanitizers;
 
-Json readJson(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  return Json::parse(in);
-}
+using mcopt::test::readJson;
 
 Eigen::VectorXd row(const Json& matrix, std::size_t k) {
   const std::vector<double> v = matrix.at(k).get<std::vector<double>>();

@@ -12,6 +12,13 @@
 
 namespace mcopt::test {
 
+/// Under AddressSanitizer the executables run ~10× slower: tests run lighter variants there.
+#ifdef MCOPT_UNDER_SANITIZERS
+inline constexpr bool kUnderSanitizers = true;
+#else
+inline constexpr bool kUnderSanitizers = false;
+#endif
+
 inline std::filesystem::path sourceDir() { return MCOPT_SOURCE_DIR; }
 #ifdef MCOPT_SHARED_DIR
 inline std::filesystem::path sharedDir() { return MCOPT_SHARED_DIR; }
