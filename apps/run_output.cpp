@@ -1,6 +1,5 @@
 #include "apps/run_output.hpp"
 
-#include <algorithm>
 #include <iomanip>
 #include <sstream>
 
@@ -127,8 +126,6 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
   if (r.release) {
     // The ball at its release and its flight to the target's height (formulation.md §10).
     const ReleaseState& b = *r.release;
-    const auto landing = std::find_if(scenario.tasks.begin(), scenario.tasks.end(),
-                                      [](const TaskSpec& t) { return t.kind == TaskKind::ThrowLanding; });
     result["release"] = {{"time", b.time},
                          {"body", scenario.ball->body},
                          {"ball_mass_kg", scenario.ball->mass},
@@ -139,8 +136,8 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
                          {"elevation_deg", b.elevation * 180.0 / 3.14159265358979323846},
                          {"flight_time", b.flightTime},
                          {"apex_above_target_m", b.apexAboveTarget},
-                         {"target", toJson(landing->target)},
-                         {"target_half_widths_m", toJson(Eigen::Vector2d(landing->upper.head<2>()))},
+                         {"target", toJson(b.target)},
+                         {"target_half_widths_m", toJson(b.targetHalfWidths)},
                          {"landing_point", toJson(b.landing)},
                          {"miss_distance_m", b.missDistance},
                          {"miss_outside_target_box_m", b.missOutsideBox}};

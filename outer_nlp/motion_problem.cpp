@@ -765,6 +765,8 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   r.landing = Vector3(f.landing.x(), f.landing.y(), landing->target.z());
   r.apexAboveTarget = f.apexAboveTarget;
   r.speed = f.speed, r.elevation = f.elevation;
+  r.target = landing->target;
+  r.targetHalfWidths = landing->upper.head<2>();
   const Eigen::Vector2d offset = f.landing - landing->target.head<2>();
   r.missDistance = offset.norm();
   r.missOutsideBox = (offset.cwiseAbs() - landing->upper.head<2>()).cwiseMax(0.0).norm();

@@ -73,6 +73,8 @@ struct ReleaseState {
   Vector3 landing = Vector3::Zero();    ///< where the flight crosses the target's height
   double apexAboveTarget = 0.0;         ///< [m]; negative: the ball never reaches that height
   double speed = 0.0, elevation = 0.0;  ///< [m/s], [rad]
+  Vector3 target = Vector3::Zero();     ///< the throw's target, world frame
+  Eigen::Vector2d targetHalfWidths = Eigen::Vector2d::Zero();  ///< its box at its height (0: a point)
   double missDistance = 0.0;            ///< |landing − target| [m]
   double missOutsideBox = 0.0;          ///< distance from the landing point to the target's box [m] (0 inside)
 };
