@@ -120,7 +120,8 @@ int runMotion(const RunOptions& o) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
     if (current.bilevel()) std::printf("   %d", sofar.history.back().inner.infeasible);
-    if (r.iterate != nullptr && scenario.ball) std::printf("   %.3e", current.release(*r.iterate)->missDistance);
+    if (const std::optional<double>& miss = sofar.history.back().missDistance) std::printf("   %.3e", *miss);
+    else if (scenario.ball) std::printf("   (restoration)");
     std::printf("\n");
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
@@ -151,6 +152,13 @@ int runMotion(const RunOptions& o) {
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
             << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";
+  if (const std::optional<ReleaseState> ball = problem.release(record.x)) {
+    // formulation.md §10: what a throw that did not converge got closest to is its written iterate.
+    std::cout << "  release            " << std::setprecision(3) << ball->speed << " m/s at "
+              << ball->elevation * 180.0 / 3.14159265358979323846 << "°, landing "
+              << ball->landing.x() << ", " << ball->landing.y() << " m; miss " << ball->missDistance << " m"
+              << (record.solver.optimal() ? "" : " (target not reached: the written iterate's miss)") << "\n";
+  }
   if (!record.reason.empty() && !record.solver.optimal()) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
   if (record.status == OuterStatus::Interrupted) return kExitInterrupted;
   return record.solver.optimal() ? 0 : kExitNotOptimal;

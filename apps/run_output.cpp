@@ -188,6 +188,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
                  {"elapsed_seconds", h.elapsedSeconds},
                  {"seconds", split(h.timings, previous)}};
     previous = h.timings;
+    if (problem.scenario().ball) line["miss_m"] = h.missDistance ? Json(*h.missDistance) : Json(nullptr);
     if (problem.bilevel())
       line["inner"] = {{"optimal", h.inner.optimal},
                        {"infeasible", h.inner.infeasible},

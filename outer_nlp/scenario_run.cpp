@@ -89,7 +89,8 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
   solveEvents.onSolve = events.onSolve;
   solveEvents.onIteration = [&](int stage, const MotionProblem& current, const IterationReport& r) {
     record.history.push_back({stage, r.iteration, r.objective, r.violation, r.dualInfeasibility, r.elapsedSeconds,
-                              r.stepSize, r.regularisation, r.barrier, r.timings, current.innerStatistics()});
+                              r.stepSize, r.regularisation, r.barrier, r.timings, current.innerStatistics(), std::nullopt});
+    if (r.iterate != nullptr && current.scenario().ball) record.history.back().missDistance = current.release(*r.iterate)->missDistance;
     record.optimisationSeconds = secondsSince(optimisationClock);
     record.totalSeconds = secondsSince(clock);
     bool go = !events.onIteration || events.onIteration(record, current, r);

@@ -6,6 +6,7 @@
 // how they show progress, how a stop is asked for and what they do with the record.
 #include <Eigen/Core>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,9 @@ struct IterationRecord {
   double stepSize = 0.0, regularisation = 0.0, barrier = 0.0;  ///< Ipopt's α_pr, δ_w and μ
   SolveTimings timings;  ///< cumulative up to this iteration
   MotionProblem::InnerStatistics inner;
+  /// With a throw: the iterate's miss distance (formulation.md §10); none where Ipopt gives
+  /// no iterate (its restoration phase).
+  std::optional<double> missDistance;
 };
 
 struct RunRecord {

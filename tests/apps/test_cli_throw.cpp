@@ -104,6 +104,39 @@ TEST_CASE("throw: the bundled throw ends optimal and its ball lands on the targe
   CHECK(miss <= 1e-3);
 }
 
+TEST_CASE("throw: an unreachable target ends not optimal, exit code non-zero, its result and miss kept",
+          "[cli][run][throw]") {
+  // The bundled target 6 m ahead with the release speed at most 2 m/s: a 2 m/s ball released
+  // below 1.5 m lands within 1 m of where it leaves the hand (range v cosθ (v sinθ + √(v² sin²θ
+  // + 2 g h)) / g ≤ 0.99 m), and the hand stays within 1.5 m of the left ankle: out of reach.
+  const test::TempDir dir;
+  const auto file = test::scenarioVariant(kThrow, dir, [](YAML::Node& r) {
+    r["tasks"][0]["speed"] = YAML::Load("[null, 2.0]");
+  }, "unreachable.yaml");
+  const auto r = test::runMcopt("run " + test::quoted(file) + " --out " + test::quoted(dir.path() / "out") +
+                                " --max-iterations " + (kUnderSanitizers ? "2" : "15"));
+  INFO(r.all());
+  CHECK(r.exitCode == 4);  // not optimal
+  CHECK_THAT(r.output, Contains("target not reached: the written iterate's miss"));
+  const Json result = readJson(dir.path() / "out/result.json");
+  CHECK(result.at("status") != "optimal");
+  const Json& release = result.at("release");
+  const std::vector<double> landing = release.at("landing_point").get<std::vector<double>>();
+  const std::vector<double> target = release.at("target").get<std::vector<double>>();
+  const double miss = std::hypot(landing[0] - target[0], landing[1] - target[1]);
+  CHECK(release.at("miss_distance_m").get<double>() == Approx(miss).epsilon(1e-12));
+  CHECK(miss > 1.0);
+  // Every iterate's miss is in the history (null in the restoration phase), none near the target.
+  int withMiss = 0;
+  for (const Json& line : result.at("history")) {
+    REQUIRE(line.contains("miss_m"));
+    if (line.at("miss_m").is_null()) continue;
+    ++withMiss;
+    CHECK(line.at("miss_m").get<double>() > 1.0);
+  }
+  CHECK(withMiss > 0);
+}
+
 TEST_CASE("throw: every class of bad throw is refused with file, line and field", "[cli][run][throw]") {
   const test::TempDir dir;
   struct Case {
