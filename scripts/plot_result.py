@@ -164,6 +164,10 @@ def convergence_figure(result, out, written):
     ax_obj.set_title(f"Ipopt's convergence: {len(history)} iterations, {result.get('status', '?')}")
     for key, label in (("violation", "constraint violation"), ("dual_infeasibility", "dual infeasibility")):
         ax_inf.plot(its, [max(h[key], 1e-20) for h in history], label=label)
+    if any(h.get("miss_m") is not None for h in history):
+        # A throw: each iterate's miss [m] on the same log axis (gaps: Ipopt's restoration phase).
+        ax_inf.plot(its, [None if h.get("miss_m") is None else max(h["miss_m"], 1e-20) for h in history],
+                    label="throw's miss distance [m]", color="tab:red", linewidth=0.8)
     ax_inf.set_yscale("log")
     ax_inf.set_xlabel("iteration (all stages in turn)")
     ax_inf.legend()
