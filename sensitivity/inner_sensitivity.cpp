@@ -34,7 +34,8 @@ std::string SensitivityDiagnostics::describe() const {
   s << "KKT " << size << " × " << size << ": " << activeRows << " active rows, " << activeCones << " active cones, "
     << unloadedContacts << " unloaded contacts";
   if (weaklyActive > 0) s << "; " << weaklyActive << " weakly active constraints left out (one-sided derivatives)";
-  if (reciprocalCondition < 1e-13) s << "; near-singular (reciprocal condition " << reciprocalCondition << ")";
+  if (nearSingular())
+    s << "; near-singular (reciprocal condition " << reciprocalCondition << ", pivot ratio " << pivotRatio << ")";
   return s.str();
 }
 
@@ -326,14 +327,20 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   if (m.sparseFactor) {
     const bool factorised = m.sparseFactor->factorize(system, n + 6);
     m.diagnostics.reciprocalCondition = factorised ? m.sparseFactor->reciprocalCondition() : 0.0;
+    m.diagnostics.pivotRatio = factorised ? m.sparseFactor->pivotRatio() : 0.0;
     m.diagnostics.analysisReused = m.sparseFactor->reusedAnalysis();
   } else {
     Eigen::PartialPivLU<Eigen::MatrixXd>& lu = m.luBySize[static_cast<std::size_t>(next - m.smallest)];
     lu.compute(system);
     m.diagnostics.reciprocalCondition = reciprocalConditionEstimate(system, lu, m.estimateX, m.estimateSign, m.estimateZ);
+    const auto pivots = lu.matrixLU().diagonal().cwiseAbs();
+    m.diagnostics.pivotRatio = pivots.minCoeff() / pivots.maxCoeff();
   }
   if (!std::isfinite(m.diagnostics.reciprocalCondition)) m.diagnostics.reciprocalCondition = 0.0;
-  m.useRankRevealing = m.diagnostics.reciprocalCondition < 1e-13;
+  if (!std::isfinite(m.diagnostics.pivotRatio)) m.diagnostics.pivotRatio = 0.0;
+  // Either figure: the estimate can miss an exact dependency (SensitivityDiagnostics::pivotRatio:
+  // slsqp's active set on the lean reach's still hand), and the LU then solves to NaN.
+  m.useRankRevealing = m.diagnostics.nearSingular();
   if (m.useRankRevealing) {
     m.backendInUse = KktBackend::Dense;
     double padding = system.cwiseAbs().maxCoeff();

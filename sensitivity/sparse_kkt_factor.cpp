@@ -26,7 +26,7 @@ struct SparseKktFactor::Impl {
   std::vector<int> columnStart, rowIndex;
   std::vector<double> values;
   bool reused = false;
-  double reciprocalCondition = 0.0;
+  double reciprocalCondition = 0.0, pivotRatio = 0.0;
   // KLU
   klu_common common{};
   klu_symbolic* symbolic = nullptr;
@@ -99,16 +99,19 @@ struct SparseKktFactor::Impl {
   }
 
   bool factorNumeric() {
-    reciprocalCondition = 0.0;
+    reciprocalCondition = pivotRatio = 0.0;
     if (library == Library::Klu) {
       if (!factorKlu(reused)) return false;
       if (klu_condest(columnStart.data(), values.data(), symbolic, numeric, &common) == 0) return false;
       reciprocalCondition = 1.0 / common.condest;
+      if (klu_rcond(symbolic, numeric, &common) == 0) return false;
+      pivotRatio = common.rcond;
     } else {
       if (!factorUmfpack()) return false;
-      reciprocalCondition = info[UMFPACK_RCOND];
+      reciprocalCondition = pivotRatio = info[UMFPACK_RCOND];
     }
     if (!std::isfinite(reciprocalCondition)) reciprocalCondition = 0.0;
+    if (!std::isfinite(pivotRatio)) pivotRatio = 0.0;
     return true;
   }
 
@@ -186,6 +189,7 @@ bool SparseKktFactor::factorize(const Eigen::SparseMatrix<double>& system) {
 
 bool SparseKktFactor::reusedAnalysis() const { return impl_->reused; }
 double SparseKktFactor::reciprocalCondition() const { return impl_->reciprocalCondition; }
+double SparseKktFactor::pivotRatio() const { return impl_->pivotRatio; }
 
 void SparseKktFactor::solveInPlace(Eigen::Ref<Eigen::MatrixXd> x) {
   Impl& m = *impl_;

@@ -39,6 +39,9 @@ class SparseKktFactor {
   /// upper bound of the reciprocal, as the dense path's). UMFPACK: its Info[UMFPACK_RCOND],
   /// min|U_ii| / max|U_ii| — a rough figure, the only one UMFPACK gives.
   double reciprocalCondition() const;
+  /// min|U_ii| / max|U_ii| of the last factorisation (KLU: klu_rcond; UMFPACK: the same figure
+  /// as reciprocalCondition()). Unlike the estimate it sees an exact dependency at once.
+  double pivotRatio() const;
   /// x ← K⁻¹ x for every column of x (rows = the system's size), with no allocation.
   void solveInPlace(Eigen::Ref<Eigen::MatrixXd> x);
 

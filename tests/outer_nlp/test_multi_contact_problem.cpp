@@ -186,22 +186,35 @@ TEST_CASE("multi-contact outer problem: with the reference contact alone every f
   CHECK(physics.energy == Approx(r.energy).epsilon(1e-12));
 }
 
-TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios evaluate with every formulation",
+TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios evaluate with every formulation and inner solver",
           "[outer][multi-contact]") {
   for (const char* name : {"hrp2_weight_shift.yaml", "hrp2_lean_reach.yaml"}) {
     Scenario s = loadScenario(test::sourceDir() / "scenarios" / name);
     s.samples = 20;
-    for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
-      s.contactForces = forces;
+    // Bilevel with each inner solver: the NLP solvers' active sets may hold dependent rows
+    // (the lean reach's hand, still over its window, with slsqp or ipopt inside), whose KKT
+    // system the sensitivity must solve in the least-norm sense, not by an LU that returned
+    // NaN (Hager–Higham estimated it well conditioned; sensitivity/inner_sensitivity.cpp).
+    struct Run {
+      ContactForces forces;
+      const char* innerSolver;
+    };
+    for (const Run run : {Run{ContactForces::Bilevel, "active-set"}, Run{ContactForces::Bilevel, "slsqp"},
+                          Run{ContactForces::Bilevel, "ipopt"}, Run{ContactForces::Splines, ""},
+                          Run{ContactForces::Variables, ""}}) {
+      s.contactForces = run.forces;
+      if (run.forces == ContactForces::Bilevel) s.inner.solverName = run.innerSolver;
       MotionProblem problem(s);
       const Eigen::VectorXd x = problem.initialPoint(s.start, s.end);
-      Eigen::VectorXd g, gradient;
+      Eigen::VectorXd g, gradient, jacobian(problem.jacobianNonZeros());
       problem.constraints(x, g);
       problem.objectiveGradient(x, gradient);
-      INFO(name << ", " << toString(forces));
+      problem.jacobianValues(x, jacobian);
+      INFO(name << ", " << toString(run.forces) << " " << run.innerSolver);
       CHECK(std::isfinite(problem.objective(x)));
       CHECK(g.allFinite());
       CHECK(gradient.allFinite());
+      CHECK(jacobian.allFinite());
       CHECK(problem.infeasibleSamples() == 0);  // the initial motion (a still posture) is carried by the soles
       int closureRows = 0;
       for (int r = 0; r < problem.constraintCount(); ++r) closureRows += problem.rowKind(r) == ConstraintKind::Closure;
