@@ -4,6 +4,7 @@
 // draws its flight; every class of bad throw is refused with file, line and field.
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
@@ -122,6 +123,21 @@ TEST_CASE("throw: the bundled throw ends optimal and its ball lands on the targe
 TEST_CASE("throw: the one-foot throw ends optimal and its ball lands on the target", "[cli][run][throw]") {
   const test::TempDir dir;
   runThrowAndCheckItsBall(test::sourceDir() / "scenarios/hrp2_throw_one_foot.yaml", dir);
+}
+
+TEST_CASE("throw: the hand-supported throw ends optimal and its ball lands on the target", "[cli][run][throw]") {
+  const test::TempDir dir;
+  const Json result = runThrowAndCheckItsBall(test::sourceDir() / "scenarios/hrp2_throw_hand_support.yaml", dir);
+  // The left hand is a contact over its window only (the release, at 1.4 s, inside it).
+  const Json& contacts = result.at("contacts");
+  const auto hand = std::find_if(contacts.begin(), contacts.end(), [](const Json& c) { return c.at("name") == "l_hand"; });
+  REQUIRE(hand != contacts.end());
+  const std::vector<double> time = result.at("time").get<std::vector<double>>();
+  for (std::size_t k = 0; k < time.size(); ++k) {
+    INFO("t = " << time[k]);
+    const bool inWindow = time[k] >= 0.8 - 1e-9 && time[k] <= 1.6 + 1e-9;
+    CHECK(hand->at("active").at(k).get<bool>() == inWindow);
+  }
 }
 
 TEST_CASE("throw: the free-release throw ends optimal and its ball lands on the target", "[cli][run][throw]") {
