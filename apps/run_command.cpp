@@ -8,11 +8,16 @@
 // complete result.
 #include <atomic>
 #include <csignal>
+#include <filesystem>
 #include <cstdio>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "apps/commands.hpp"
+#include "apps/json_io.hpp"
 #include "apps/run_output.hpp"
 #include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
@@ -35,7 +40,28 @@ struct RunOptions {
   int maxIterations = -1;
   std::string innerSolver;                ///< "", or an inner solver: overrides the scenario
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
+  std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
 };
+
+/// A result's motion (result.json `parameters` by joint, `duration`) as the run's start.
+void startFromResult(Scenario& scenario, const std::filesystem::path& from) {
+  const std::filesystem::path file = std::filesystem::is_directory(from) ? from / "result.json" : from;
+  const json_io::Json result = json_io::readFile(file);
+  if (!result.is_object()) throw InputError(file.string() + ": expected a result.json object");
+  for (const char* field : {"parameters", "duration"})
+    if (!result.contains(field)) throw InputError(file.string() + ": " + field + ": missing (not a result of mcopt run?)");
+  const json_io::Json& parameters = result["parameters"];
+  if (!parameters.is_object()) throw InputError(file.string() + ": parameters: expected an object of joint names");
+  std::map<std::string, std::vector<double>> byJoint;
+  for (const auto& [joint, values] : parameters.items()) {
+    const Eigen::VectorXd v = json_io::numbers(file, values, "parameters." + joint);
+    byJoint[joint] = std::vector<double>(v.data(), v.data() + v.size());
+  }
+  const json_io::Json& duration = result["duration"];
+  if (!duration.is_number()) throw InputError(file.string() + ": duration: expected a number");
+  startFromMotion(scenario, byJoint, duration.get<double>(), file.string());
+}
+
 
 constexpr int kExitNotOptimal = 4;
 constexpr int kExitInterrupted = 130;
@@ -67,6 +93,7 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 int runMotion(const RunOptions& o) {
   Scenario scenario = loadScenario(o.scenario);
   applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver});
+  if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   MotionProblem problem(scenario);
   std::cout << "mcopt run " << o.scenario << "\n";
@@ -90,6 +117,7 @@ int runMotion(const RunOptions& o) {
   std::signal(SIGTERM, requestStop);
 
   if (scenario.configurationOptimisation) std::cout << "configuration optimisation (report §3.5)\n";
+  if (scenario.initialMotion) std::cout << "  starting from the motion of " << o.startFrom << "\n";
   double lastCheckpoint = 0.0;
   ScenarioRunEvents events;
   events.onPosture = [](const std::string& which, const PostureOutcome& p) {
@@ -182,6 +210,10 @@ Runner addRun(CLI::App& command) {
   command.add_option("--inner-solver", o->innerSolver,
                      "active-set, slsqp or ipopt: override the scenario's inner.solver (bilevel, formulation.md §7)")
       ->check(CLI::IsMember(innerSolverNames()));
+  command.add_option("--start-from", o->startFrom,
+                     "a result folder (or its result.json): start from its motion instead of the interpolated one; "
+                     "configuration optimisation off; with another contact-force formulation its forces from the "
+                     "inner problem along it");
   command.add_option("--checkpoint-seconds", o->checkpointSeconds,
                      "write the current iterate (status running) at most this often; 0: every iteration, "
                      "negative: never")

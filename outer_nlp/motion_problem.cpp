@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 #include "core/contact_maps.hpp"
 #include "core/errors.hpp"
@@ -408,9 +410,16 @@ void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& up
 }
 
 Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end) {
+  return pointFromMotion(parametrization_.interpolatedMotion(start, end), scenario_.duration.initial);
+}
+
+Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionParameters, double T) {
+  if (motionParameters.size() != parameterCount_)
+    throw std::invalid_argument("pointFromMotion: " + std::to_string(motionParameters.size()) + " spline parameters for " +
+                                std::to_string(parameterCount_));
   Eigen::VectorXd x = Eigen::VectorXd::Zero(variableCount_);
-  x.head(parameterCount_) = parametrization_.interpolatedMotion(start, end);
-  if (durationIsFree()) x[parameterCount_] = scenario_.duration.initial;
+  x.head(parameterCount_) = motionParameters;
+  if (durationIsFree()) x[parameterCount_] = T;
   if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
     // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).

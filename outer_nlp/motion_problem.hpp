@@ -158,6 +158,10 @@ class MotionProblem final : public NlpProblem {
   /// duration, force variables fitted to the inner problem's wrenches along that motion
   /// (splines, variables), and epigraph slacks at max(P, 0) of that motion.
   Eigen::VectorXd initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end);
+  /// The same from a given motion (spline parameters, duration T): a result's motion as the
+  /// start of another formulation — the bilevel optimum's forces are then a feasible point of
+  /// the single-level ones (formulation.md §9).
+  Eigen::VectorXd pointFromMotion(const Eigen::VectorXd& motionParameters, double T);
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
   double duration(const Eigen::VectorXd& x) const {
     return durationIsFree() ? x[parameterCount_] : scenario_.duration.initial;

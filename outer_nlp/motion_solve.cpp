@@ -45,13 +45,24 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
       // small barrier parameter keeps Ipopt near it instead of re-centring it (measured on the
       // bilevel weight shift: from the Gauss–Newton stage's iterate, sample-differences ended
       // optimal after 79 iterations with it, and not in 1000 without it; docs/scenarios.md).
+      // So does the first solve from a given motion (--start-from: another run's optimum).
       // Ours first: the scenario's `solver` options still override it.
-      if (k > 0 || stage.rounds > 0) {
+      if (k > 0 || stage.rounds > 0 || scenario.initialMotion) {
         SolverOption barrier;
         barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = 1e-4;
-        barrier.text = "1e-4", barrier.origin = stage.rounds > 0 ? "torque-limit screening: " : "continuation stage: ";
+        barrier.text = "1e-4";
+        barrier.origin = stage.rounds > 0 ? "torque-limit screening: " : k > 0 ? "continuation stage: " : "--start-from: ";
         roundSettings.options.insert(roundSettings.options.begin(), barrier);
       }
+      // A given motion is taken as it is: Ipopt's default pushes of 1e-2 off the bounds (of
+      // variables and of inequality rows) would move a feasible start off its own point, the
+      // bilevel optimum that --start-from gives another formulation (formulation.md §9).
+      if (k == 0 && stage.rounds == 0 && scenario.initialMotion)
+        for (const char* push : {"bound_push", "bound_frac", "slack_bound_push", "slack_bound_frac"}) {
+          SolverOption o;
+          o.name = push, o.type = SolverOption::Type::Number, o.number = 1e-9, o.text = "1e-9", o.origin = "--start-from: ";
+          roundSettings.options.insert(roundSettings.options.begin(), o);
+        }
       outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
         return !events.onIteration || events.onIteration(k, current, r);
       });

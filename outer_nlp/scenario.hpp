@@ -164,6 +164,13 @@ struct Scenario {
   bool fixStart = false, fixEnd = false;
   bool configurationOptimisation = true;
   int configurationIterations = 500;
+  /// A given initial motion instead of the interpolation from start to end (`mcopt run
+  /// --start-from`, outer_nlp/scenario_run.hpp `startFromMotion`).
+  struct InitialMotion {
+    Eigen::VectorXd parameters;  ///< spline parameters, joint by joint (MotionProblem's layout)
+    double duration = 0.0;       ///< T [s]
+  };
+  std::optional<InitialMotion> initialMotion;
 
   std::vector<SolverOption> solverOptions;
   HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/scenarios.md)

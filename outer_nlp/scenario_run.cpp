@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <sstream>
 
 #include "core/errors.hpp"
 #include "inner_qp/inner_solver.hpp"
@@ -64,6 +66,45 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
   }
 }
 
+void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector<double>>& parametersByJoint,
+                     double duration, const std::string& origin) {
+  const int n = static_cast<int>(scenario.robot.joints.size()), m = scenario.controlPoints - 4;
+  Scenario::InitialMotion motion;
+  motion.parameters.resize(n * m);
+  for (int j = 0; j < n; ++j) {
+    const std::string& name = scenario.robot.joints[static_cast<std::size_t>(j)].name;
+    const auto found = parametersByJoint.find(name);
+    if (found == parametersByJoint.end())
+      throw InputError(origin + ": parameters." + name + ": missing (the scenario's robot has this joint)");
+    if (static_cast<int>(found->second.size()) != m)
+      throw InputError(origin + ": parameters." + name + ": " + std::to_string(found->second.size()) +
+                       " spline parameters, the scenario has " + std::to_string(m) + " (control_points " +
+                       std::to_string(scenario.controlPoints) + " − 4)");
+    for (int l = 0; l < m; ++l) {
+      const double value = found->second[static_cast<std::size_t>(l)];
+      if (!std::isfinite(value)) throw InputError(origin + ": parameters." + name + ": not a finite number");
+      motion.parameters[j * m + l] = value;
+    }
+  }
+  if (parametersByJoint.size() != static_cast<std::size_t>(n))
+    throw InputError(origin + ": parameters: " + std::to_string(parametersByJoint.size()) + " joints, the scenario's robot has " +
+                     std::to_string(n));
+  const DurationSpec& T = scenario.duration;
+  if (!std::isfinite(duration) || duration < T.lower - 1e-12 || duration > T.upper + 1e-12) {
+    std::ostringstream what;
+    what << origin << ": duration: " << duration << " s is outside the scenario's ";
+    if (T.free())
+      what << "[" << T.lower << ", " << T.upper << "] s";
+    else
+      what << T.initial << " s";
+    throw InputError(what.str());
+  }
+  motion.duration = std::clamp(duration, T.lower, T.upper);
+  for (int j = 0; j < n; ++j) scenario.start[j] = motion.parameters[j * m], scenario.end[j] = motion.parameters[j * m + m - 1];
+  scenario.configurationOptimisation = false;
+  scenario.initialMotion = std::move(motion);
+}
+
 RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events) {
   const auto clock = std::chrono::steady_clock::now();
   RunRecord record;
@@ -80,7 +121,9 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
   }
   record.configurationSeconds = secondsSince(clock);
 
-  const Eigen::VectorXd x0 = problem.initialPoint(start, end);
+  const Eigen::VectorXd x0 = scenario.initialMotion
+                                 ? problem.pointFromMotion(scenario.initialMotion->parameters, scenario.initialMotion->duration)
+                                 : problem.initialPoint(start, end);
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;

@@ -6,6 +6,7 @@
 // how they show progress, how a stop is asked for and what they do with the record.
 #include <Eigen/Core>
 #include <functional>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,15 @@ struct ScenarioOverrides {
 
 /// Applies the overrides; throws InputError for a value that is not one of the choices.
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& overrides);
+
+/// Starts the scenario's motion optimisation from a given motion (a result's: `mcopt run
+/// --start-from`): its spline parameters by joint name, each the scenario's control points − 4
+/// values, and its duration. The start and end postures become the motion's first and last
+/// control points (fixed if the scenario fixes them) and configuration optimisation is off.
+/// Throws InputError "<origin>: parameters.<joint>: …" or "<origin>: duration: …" for a motion
+/// that does not fit the scenario.
+void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector<double>>& parametersByJoint,
+                     double duration, const std::string& origin);
 
 /// One static posture found by configuration optimisation (report §3.5).
 struct PostureOutcome {

@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "common/json_file.hpp"
@@ -584,4 +585,72 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
   CHECK(refused.exitCode != 0);
   CHECK_THAT(refused.errors, Contains("--inner-solver"));
   CHECK_FALSE(std::filesystem::exists(dir.path() / "no"));
+}
+
+TEST_CASE("run: the variables formulation started from the bilevel optimum starts feasible at its criterion and ends no higher",
+          "[cli][run][multi-contact]") {
+  // formulation.md §9: the bilevel optimum's wrenches are a feasible point of the single-level
+  // formulations, so from it `variables` (which optimises the wrenches with the motion) can only
+  // do as well or better. docs/scenarios.md, "Multi-contact: the same physics".
+  if (kUnderSanitizers) return;  // two whole optimisations: the Release build runs them
+  const test::TempDir dir;
+  const auto leanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
+  const auto bilevel = test::runMcopt("run " + test::quoted(leanReach) + " --out " + test::quoted(dir.path() / "bilevel"));
+  INFO(bilevel.all());
+  REQUIRE(bilevel.exitCode == 0);
+  const Json first = readJson(dir.path() / "bilevel/result.json");
+  REQUIRE(first.at("contact_forces") == "bilevel");
+  const auto single = test::runMcopt("run " + test::quoted(leanReach) + " --contact-forces variables --start-from " +
+                                     test::quoted(dir.path() / "bilevel") + " --out " + test::quoted(dir.path() / "variables"));
+  INFO(single.all());
+  CHECK_THAT(single.output, Contains("starting from the motion of"));
+  CHECK(single.exitCode == 0);
+  const Json second = readJson(dir.path() / "variables/result.json");
+  CHECK(second.at("status") == "optimal");
+  CHECK(second.at("max_violation").get<double>() <= 1e-6);
+  // Its first iterate is the bilevel optimum, feasible, at the same criterion.
+  const Json& start = second.at("history").at(0);
+  CHECK(start.at("objective").get<double>() == Approx(first.at("objective_value").get<double>()).epsilon(1e-9));
+  CHECK(start.at("violation").get<double>() <= 1e-6);
+  const double bilevelCriterion = first.at("objective_value").get<double>();
+  CHECK(second.at("objective_value").get<double>() <= bilevelCriterion * (1.0 + 1e-6));
+}
+
+TEST_CASE("run: --start-from refuses a motion that does not fit the scenario, naming the file and field", "[cli][run]") {
+  const test::TempDir dir;
+  // A real result of the kick (a few iterations), then copies of it with one field broken.
+  const auto out = dir.path() / "kick";
+  const auto r = test::runMcopt("run " + test::quoted(kKick) + " --out " + test::quoted(out) +
+                                " --max-iterations 1 --configuration-optimisation off");
+  INFO(r.all());
+  REQUIRE(std::filesystem::exists(out / "result.json"));
+  const Json result = readJson(out / "result.json");
+  struct Case {
+    const char* what;
+    std::function<void(Json&)> edit;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"a joint missing", [](Json& j) { j["parameters"].erase("RLEG_JOINT3"); }, "parameters.RLEG_JOINT3: missing"},
+      {"too few parameters", [](Json& j) { j["parameters"]["RLEG_JOINT3"].erase(0); },
+       "parameters.RLEG_JOINT3: 4 spline parameters, the scenario has 5"},
+      {"a parameter that is not a number", [](Json& j) { j["parameters"]["RLEG_JOINT3"][1] = "fast"; },
+       "parameters.RLEG_JOINT3[1]: expected a number"},
+      {"a duration the scenario does not have", [](Json& j) { j["duration"] = 2.5; },
+       "duration: 2.5 s is outside the scenario's 1.6 s"},
+      {"no duration", [](Json& j) { j.erase("duration"); }, "duration: missing"},
+  };
+  for (const Case& c : cases) {
+    SECTION(c.what) {
+      Json broken = result;
+      c.edit(broken);
+      const auto file = dir.write(std::string("broken.json"), broken.dump());
+      const auto refused = test::runMcopt("run " + test::quoted(kKick) + " --start-from " + test::quoted(file) +
+                                          " --out " + test::quoted(dir.path() / "refused"));
+      INFO(refused.all());
+      CHECK(refused.exitCode == 2);
+      CHECK_THAT(refused.errors, Contains(file.string() + ": " + c.expected));
+      CHECK_FALSE(std::filesystem::exists(dir.path() / "refused"));
+    }
+  }
 }
