@@ -75,7 +75,8 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
   checkpoint.message = "Ipopt was running when this was written";
   checkpoint.reason = "checkpoint after iteration " + std::to_string(r.iteration) +
                       "; the run had not ended (a run that ends overwrites it)";
-  checkpoint.x = *r.iterate;
+  // A continuation stage of another energy form has its own variables after the motion's.
+  checkpoint.x = r.iterate->size() == problem.variableCount() ? *r.iterate : problem.pointFrom(problem, *r.iterate);
   if (r.progress != nullptr) checkpoint.solver = *r.progress;
   checkpoint.solver.status = checkpoint.status;
   checkpoint.solver.message = checkpoint.message;
@@ -133,7 +134,10 @@ int runMotion(const RunOptions& o) {
     if (solve.stages > 1) {
       std::cout << "; stage " << solve.stage + 1 << " of " << solve.stages << ": ν = "
                 << solve.scenario.actuators.frictionSharpness << " s/rad";
-      if (solve.scenario.energyForm == EnergyForm::SmoothMaximum) std::cout << ", ε = " << solve.scenario.smoothing << " W";
+      if (solve.scenario.energyForm == EnergyForm::SmoothMaximum)
+        std::cout << ", ε = " << solve.scenario.smoothing << " W";
+      else
+        std::cout << ", epigraph";
       std::cout << ", " << solve.scenario.samples << " samples";
     }
     if (solve.problem.omittedTorqueRowCount() > 0)

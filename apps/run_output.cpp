@@ -204,7 +204,8 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
   for (const StageOutcome& stage : record.stages) {
     all += stage.timings;
     stages.push_back({{"friction_sharpness", stage.frictionSharpness},
-                      {"smoothing", stage.smoothing},
+                      {"energy_form", stage.energyForm == EnergyForm::Epigraph ? "epigraph" : "smooth_max"},
+                      {"smoothing", stage.energyForm == EnergyForm::Epigraph ? Json(nullptr) : Json(stage.smoothing)},
                       {"samples", stage.samples},
                       {"hessian", toString(stage.hessian)},
                       {"status", toString(stage.status)},

@@ -162,6 +162,11 @@ class MotionProblem final : public NlpProblem {
   /// start of another formulation — the bilevel optimum's forces are then a feasible point of
   /// the single-level ones (formulation.md §9).
   Eigen::VectorXd pointFromMotion(const Eigen::VectorXd& motionParameters, double T);
+  /// The same from `other`'s point x (another continuation stage's problem, whose energy form
+  /// or formulation may lay out other variables after the shared spline parameters and T).
+  Eigen::VectorXd pointFrom(const MotionProblem& other, const Eigen::VectorXd& x) {
+    return pointFromMotion(other.motionParameters(x), other.duration(x));
+  }
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
   double duration(const Eigen::VectorXd& x) const {
     return durationIsFree() ? x[parameterCount_] : scenario_.duration.initial;

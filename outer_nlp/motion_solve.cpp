@@ -16,9 +16,12 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     const Scenario stageScenario = continuationStage(scenario, static_cast<std::size_t>(k));
     const std::unique_ptr<MotionProblem> stageProblem = last ? nullptr : std::make_unique<MotionProblem>(stageScenario);
     MotionProblem& full = last ? problem : *stageProblem;
-    if (full.variableCount() != problem.variableCount())
-      throw InputError("continuation stage " + std::to_string(k + 1) +
-                       ": its samples change the per-sample variables (epigraph slacks, contact_forces: variables)");
+    // A stage of another energy form lays out other variables after the shared spline
+    // parameters and T (the epigraph's slacks): it starts from the motion reached, its own
+    // variables set from it (MotionProblem::pointFrom; the smooth maximum's optimum, then the
+    // exact epigraph form: docs/scenarios.md, "Continuation").
+    const bool remapped = k > 0 && x.size() != full.variableCount();
+    if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
     std::vector<bool> omitted;
     if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
     StageOutcome stage;
@@ -26,6 +29,7 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     stage.smoothing = stageScenario.smoothing;
     stage.samples = stageScenario.samples;
     stage.hessian = stageScenario.hessian;
+    stage.energyForm = stageScenario.energyForm;
     IpoptOutcome outcome;
     int joined = 0;
     for (;;) {
@@ -55,12 +59,14 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
         roundSettings.options.insert(roundSettings.options.begin(), barrier);
       }
       // A given motion is taken as it is: Ipopt's default pushes of 1e-2 off the bounds (of
-      // variables and of inequality rows) would move a feasible start off its own point, the
-      // bilevel optimum that --start-from gives another formulation (formulation.md §9).
-      if (k == 0 && stage.rounds == 0 && scenario.initialMotion)
+      // variables and of inequality rows) would move a feasible start off its own point — the
+      // bilevel optimum that --start-from gives another formulation (formulation.md §9), or a
+      // smooth-maximum stage's optimum with the epigraph's slacks at max(P, 0), many at 0.
+      if (stage.rounds == 0 && (k == 0 ? scenario.initialMotion.has_value() : remapped))
         for (const char* push : {"bound_push", "bound_frac", "slack_bound_push", "slack_bound_frac"}) {
           SolverOption o;
-          o.name = push, o.type = SolverOption::Type::Number, o.number = 1e-9, o.text = "1e-9", o.origin = "--start-from: ";
+          o.name = push, o.type = SolverOption::Type::Number, o.number = 1e-9, o.text = "1e-9";
+          o.origin = k == 0 ? "--start-from: " : "continuation stage: ";
           roundSettings.options.insert(roundSettings.options.begin(), o);
         }
       outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
@@ -90,7 +96,8 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     // only restart from its optimum (measured: a restart with sample-differences wandered off
     // the lean reach's optimum; docs/scenarios.md).
     const bool scenarioProblem = stageScenario.actuators.frictionSharpness == scenario.actuators.frictionSharpness &&
-                                 stageScenario.smoothing == scenario.smoothing && stageScenario.samples == scenario.samples;
+                                 stageScenario.smoothing == scenario.smoothing && stageScenario.samples == scenario.samples &&
+                                 stageScenario.energyForm == scenario.energyForm;
     if (!last && scenarioProblem && usable && outcome.optimal()) {
       result.solver = outcome;
       break;
@@ -105,6 +112,9 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
       break;
     }
   }
+  // The run's iterate in the scenario's own layout, also when an earlier stage's is the last usable one.
+  if (result.solver.x.size() > 0 && result.solver.x.size() != problem.variableCount())
+    result.solver.x = problem.pointFrom(problem, result.solver.x);
   return result;
 }
 

@@ -20,6 +20,7 @@ struct StageOutcome {
   double frictionSharpness = 0.0, smoothing = 0.0;
   int samples = 0;
   HessianOption hessian = HessianOption::SampleDifferences;
+  EnergyForm energyForm = EnergyForm::SmoothMaximum;
   OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
   double objective = 0.0;                           ///< of its last solve
   int iterations = 0;                               ///< over its rounds

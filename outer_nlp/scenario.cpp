@@ -533,8 +533,15 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       const YAML::Node stage = stages[k];
       const std::string field = "continuation[" + std::to_string(k) + "]";
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
-      yaml::rejectUnknownKeys(file, stage, field, {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations"});
-      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1};
+      yaml::rejectUnknownKeys(file, stage, field,
+                              {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy"});
+      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1, s.energyForm};
+      if (stage["energy"]) {
+        const std::string form = yaml::text(file, stage["energy"], field + ".energy");
+        if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
+        else if (form == "epigraph") c.energyForm = EnergyForm::Epigraph;
+        else throw InputError(where(file, stage["energy"], field + ".energy") + "expected smooth_max or epigraph, got '" + form + "'");
+      }
       if (stage["hessian"]) {
         try {
           c.hessian = parseHessianOption(yaml::text(file, stage["hessian"], field + ".hessian"));
@@ -546,14 +553,15 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       if (stage["friction_sharpness"])
         c.frictionSharpness = yaml::positive(file, stage["friction_sharpness"], field + ".friction_sharpness");
       if (stage["smoothing"]) {
-        if (s.energyForm != EnergyForm::SmoothMaximum)
+        if (c.energyForm != EnergyForm::SmoothMaximum)
           throw InputError(where(file, stage["smoothing"], field + ".smoothing") + "only the smooth_max form is smoothed");
         c.smoothing = yaml::positive(file, stage["smoothing"], field + ".smoothing");
       }
       if (stage["samples"]) {
         // Per-sample variables (epigraph slacks, wrenches as variables) do not carry over
         // from one grid to another; the spline parameters and force splines do.
-        if (s.energyForm == EnergyForm::Epigraph || (!s.contacts.empty() && s.contactForces == ContactForces::Variables))
+        if (s.energyForm == EnergyForm::Epigraph || c.energyForm == EnergyForm::Epigraph ||
+            (!s.contacts.empty() && s.contactForces == ContactForces::Variables))
           throw InputError(where(file, stage["samples"], field + ".samples") +
                            "the epigraph form and contact_forces: variables have variables per sample; a stage "
                            "cannot change the samples");
@@ -578,6 +586,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
     stage.smoothing = scenario.continuation[k].smoothing;
     stage.samples = scenario.continuation[k].samples;
     stage.hessian = scenario.continuation[k].hessian;
+    stage.energyForm = scenario.continuation[k].energyForm;
   }
   return stage;
 }

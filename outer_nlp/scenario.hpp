@@ -186,6 +186,10 @@ struct Scenario {
     int samples = 0;                 ///< N: a coarser grid, the same spline parameters
     HessianOption hessian = HessianOption::SampleDifferences;  ///< the scenario's unless the stage names one
     int maxIterations = -1;          ///< Ipopt's max_iter for the stage; -1: the scenario's
+    /// The stage's energy form: a smooth-maximum stage before the exact epigraph form, whose
+    /// slack variables the next stage sets at max(P, 0) of the motion reached (MotionProblem::
+    /// pointFrom; docs/scenarios.md, "Continuation").
+    EnergyForm energyForm = EnergyForm::SmoothMaximum;
   };
   std::vector<ContinuationStage> continuation;
 };

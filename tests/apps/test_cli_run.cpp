@@ -284,6 +284,47 @@ TEST_CASE("run: a continuation solves its stages in turn, each from the last one
   CHECK(split <= parts + 1e-9);
 }
 
+TEST_CASE("run: a smooth-maximum stage before the exact epigraph form, whose slacks start at max(P, 0) of its motion",
+          "[cli][run]") {
+  // The offset-free criterion (docs/scenarios.md, "Continuation"): the epigraph stage starts
+  // at the smooth stage's motion with every slack at max(P, 0) and Ipopt told to keep it, so
+  // its iterate 0 — the written result when its own limit is 0 — has the criterion of that
+  // motion's exact energy. With Ipopt's default pushes of 1e-2 off the slacks' bound it did not.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 20;
+    root["objective"] = YAML::Load("{energy: epigraph}");
+    root["continuation"] = YAML::Load("[{energy: smooth_max, smoothing: 0.01, max_iterations: 20}]");
+    root["solver"]["max_iter"] = 0;
+  });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --configuration-optimisation off");
+  INFO(r.all());
+  REQUIRE(r.exitCode == 4);  // the epigraph stage's limit of 0 iterations
+  CHECK_THAT(r.output, Contains("stage 1 of 2: ν = 1 s/rad, ε = 0.01 W, 20 samples") &&
+                           Contains("stage 2 of 2: ν = 1 s/rad, epigraph, 20 samples"));
+  const Json result = readJson(out / "result.json");
+  REQUIRE(result["continuation"].size() == 2);
+  CHECK(result["continuation"][0]["energy_form"] == "smooth_max");
+  CHECK(result["continuation"][0]["smoothing"] == 0.01);
+  CHECK(result["continuation"][1]["energy_form"] == "epigraph");
+  CHECK(result["continuation"][1]["smoothing"].is_null());
+  CHECK(result["energy_form"] == "epigraph");
+  const Json& start = result["history"].back();
+  REQUIRE(start["stage"] == 1);
+  REQUIRE(start["iteration"] == 0);
+  const double energy = result["energy"].get<double>();
+  CHECK(energy > 0.0);
+  CHECK(start["objective"].get<double>() == Approx(energy).epsilon(1e-6));
+  // A stage's energy form is checked like the scenario's.
+  const auto bad = kickVariant(dir, [](YAML::Node& root) {
+    root["continuation"] = YAML::Load("[{energy: exact}]");
+  });
+  const auto refused = test::runMcopt("run " + test::quoted(bad) + " --out " + test::quoted(dir.path() / "no"));
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains("continuation[0].energy: expected smooth_max or epigraph, got 'exact'"));
+}
+
 TEST_CASE("run: a continuation stage with its own Hessian option and iteration limit", "[cli][run]") {
   // The bundled multi-contact scenarios start with a few hundred gauss-newton iterations and
   // finish with sample-differences (docs/scenarios.md): each stage says its option, stops at its
