@@ -168,7 +168,8 @@ int runMotion(const RunOptions& o) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   if (record.status == OuterStatus::Interrupted) record.reason = "interrupted by a signal; the last iterate is written";
-  const auto [energy, violation] = writeRunOutput(o.out, problem, record);
+  const RunFiles written = writeRunOutput(o.out, problem, record);
+  const double energy = written.energy, violation = written.maxViolation;
 
   std::cout << "\nEXIT: " << record.message << "\n"
             << "  status             " << toString(record.status) << "\n"
@@ -184,10 +185,10 @@ int runMotion(const RunOptions& o) {
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
             << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";
-  if (const std::optional<ReleaseState> ball = problem.release(record.x)) {
+  if (const std::optional<ReleaseState>& ball = written.release) {
     // formulation.md §10: what a throw that did not converge got closest to is its written iterate.
     std::cout << "  release            " << std::setprecision(3) << ball->speed << " m/s at "
-              << ball->elevation * 180.0 / 3.14159265358979323846 << "°, landing "
+              << ball->elevationDegrees() << "°, landing "
               << ball->landing.x() << ", " << ball->landing.y() << " m; miss " << ball->missDistance << " m"
               << (record.solver.optimal() ? "" : " (target not reached: the written iterate's miss)") << "\n";
   }

@@ -133,7 +133,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
                          {"position", toJson(b.position)},
                          {"velocity", toJson(b.velocity)},
                          {"speed_m_s", b.speed},
-                         {"elevation_deg", b.elevation * 180.0 / 3.14159265358979323846},
+                         {"elevation_deg", b.elevationDegrees()},
                          {"flight_time", b.flightTime},
                          {"apex_above_target_m", b.apexAboveTarget},
                          {"target", toJson(b.target)},
@@ -284,6 +284,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
   files.powerFineCsv = fineCsv.str();
   files.energy = r.energy;
   files.maxViolation = violations.overall;
+  files.release = r.release;
   return files;
 }
 
@@ -304,11 +305,10 @@ void writeCheckpointFile(const std::filesystem::path& directory, const RunFiles&
   writeFileAtomically(directory / "result.json", files.result.dump(1) + "\n");
 }
 
-std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
-                                         const RunRecord& record) {
-  const RunFiles files = makeRunFiles(problem, record);
+RunFiles writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem, const RunRecord& record) {
+  RunFiles files = makeRunFiles(problem, record);
   writeRunFiles(directory, files);
-  return {files.energy, files.maxViolation};
+  return files;
 }
 
 }  // namespace mcopt::cli

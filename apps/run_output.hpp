@@ -6,6 +6,7 @@
 // content (and writes the files when asked).
 
 #include <filesystem>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -20,6 +21,7 @@ struct RunFiles {
   std::string trajectoryCsv, powerFineCsv;
   double energy = 0.0;        ///< exact ∫ Σ max(P, 0) dt at the samples
   double maxViolation = 0.0;  ///< the largest violation of any row
+  std::optional<ReleaseState> release;  ///< a throw's ball at its release (result.json `release`)
 };
 
 /// Evaluates the motion of `record.x` (regular and fine samples) and serialises it.
@@ -36,7 +38,7 @@ void writeRunFiles(const std::filesystem::path& directory, const RunFiles& files
 void writeCheckpointFile(const std::filesystem::path& directory, const RunFiles& files);
 
 /// makeRunFiles then writeRunFiles. Returns the exact energy and the largest violation.
-std::pair<double, double> writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem,
-                                         const RunRecord& record);
+/// Makes and writes the files; returns them for the run's summary.
+RunFiles writeRunOutput(const std::filesystem::path& directory, MotionProblem& problem, const RunRecord& record);
 
 }  // namespace mcopt::cli

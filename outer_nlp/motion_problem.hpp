@@ -77,6 +77,7 @@ struct ReleaseState {
   Eigen::Vector2d targetHalfWidths = Eigen::Vector2d::Zero();  ///< its box at its height (0: a point)
   double missDistance = 0.0;            ///< |landing − target| [m]
   double missOutsideBox = 0.0;          ///< distance from the landing point to the target's box [m] (0 inside)
+  double elevationDegrees() const { return elevation * 180.0 / 3.14159265358979323846; }
 };
 
 /// Everything a motion's samples say, for results (apps serialise it; nothing is re-evaluated there).
