@@ -43,24 +43,24 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
   }
 }
 
-/// Appends one row a·F_contact ≤ bound over the contact's 6 columns.
+/// Appends one row a·F ≤ bound over one contact's 6 wrench components.
 struct RowWriter {
-  Eigen::MatrixXd& rows;
-  Eigen::VectorXd& bounds;
-  std::vector<std::string>& names;
-  const std::vector<ContactSpec>& contacts;
+  ContactModelRows& out;
   Eigen::Index next = 0;
-  void add(const std::string& name, int contact, std::initializer_list<std::pair<int, double>> terms,
+  void add(std::string name, ContactRowKind kind, std::initializer_list<std::pair<int, double>> terms,
            double bound = 0.0) {
-    names.push_back(contacts[static_cast<std::size_t>(contact)].name + "." + name);
-    rows.row(next).setZero();
-    for (const auto& [component, value] : terms) rows(next, 6 * contact + component) += value;
-    bounds[next] = bound;
+    out.names[static_cast<std::size_t>(next)] = std::move(name);
+    out.kinds[static_cast<std::size_t>(next)] = kind;
+    out.rows.row(next).setZero();
+    for (const auto& [component, value] : terms) out.rows(next, component) += value;
+    out.bound[next] = bound;
     ++next;
   }
 };
 
-int rowsPerContact(const ContactProblemSettings& s) {
+}  // namespace
+
+int contactModelRowCount(const ContactProblemSettings& s) {
   switch (s.model) {
     case ContactModel::Report: return 5;                        // fz ≥ f_min, 4 CoP rows
     case ContactModel::Pyramid: return 5 + s.pyramidFacets;      // + facets
@@ -69,7 +69,62 @@ int rowsPerContact(const ContactProblemSettings& s) {
   return 0;
 }
 
-}  // namespace
+ContactModelRows contactModelRows(const ContactSpec& c, const ContactProblemSettings& settings) {
+  if (settings.model == ContactModel::Pyramid && settings.pyramidFacets < 3)
+    throw InputError("pyramid facets: need at least 3, got " + std::to_string(settings.pyramidFacets));
+  const int count = contactModelRowCount(settings);
+  ContactModelRows out;
+  out.rows.resize(count, 6);
+  out.bound.resize(count);
+  out.names.resize(static_cast<std::size_t>(count));
+  out.kinds.resize(static_cast<std::size_t>(count));
+  RowWriter rows{out};
+  using K = ContactRowKind;
+  rows.add("fz_min", K::NormalForce, {{Fz, -1.0}}, -c.minNormalForce);  // fz ≥ f_min
+  rows.add("cop_x_max", K::CenterOfPressure, {{My, -1.0}, {Fz, -c.xMax}});    // −m_y ≤ x_max fz
+  rows.add("cop_x_min", K::CenterOfPressure, {{My, 1.0}, {Fz, c.xMin}});      // x_min fz ≤ −m_y
+  rows.add("cop_y_max", K::CenterOfPressure, {{Mx, 1.0}, {Fz, -c.yMax}});     // m_x ≤ y_max fz
+  rows.add("cop_y_min", K::CenterOfPressure, {{Mx, -1.0}, {Fz, c.yMin}});     // y_min fz ≤ m_x
+  switch (settings.model) {
+    case ContactModel::Report: break;  // the friction cone is a second-order cone, not a row
+    case ContactModel::Pyramid: {
+      const int k = settings.pyramidFacets;
+      const double inscribed = c.friction * std::cos(std::numbers::pi / k);
+      for (int f = 0; f < k; ++f) {
+        const double theta = 2.0 * std::numbers::pi * f / k;
+        rows.add("facet_" + std::to_string(f), K::Friction, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
+      }
+      break;
+    }
+    case ContactModel::WrenchCone: {
+      // About the rectangle's centre (cx, cy): m'_x = m_x − cy fz, m'_y = m_y + cx fz,
+      // m'_z = m_z − cx fy + cy fx. With μ̃ = μ/√2 the pyramid |fx|, |fy| ≤ μ̃ fz is
+      // inscribed in the circular cone (Caron et al. §III), so the wrench cone admits
+      // nothing the report model forbids and forbids, besides, the yaw slip.
+      const double mu = c.friction / std::numbers::sqrt2;
+      const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
+      const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
+      rows.add("fx_max", K::Friction, {{Fx, 1.0}, {Fz, -mu}});
+      rows.add("fx_min", K::Friction, {{Fx, -1.0}, {Fz, -mu}});
+      rows.add("fy_max", K::Friction, {{Fy, 1.0}, {Fz, -mu}});
+      rows.add("fy_min", K::Friction, {{Fy, -1.0}, {Fz, -mu}});
+      int yaw = 0;
+      for (double s1 : {-1.0, 1.0})
+        for (double s2 : {-1.0, 1.0}) {
+          // m'_z ≤ μ(X+Y) fz − s1 (Y fx + μ m'_x) − s2 (X fy + μ m'_y)
+          rows.add("yaw_max_" + std::to_string(yaw), K::Yaw, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
+                       {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, s1 * mu}, {Fz, -s1 * mu * cy},
+                       {Fy, s2 * X}, {My, s2 * mu}, {Fz, s2 * mu * cx}});
+          // −m'_z ≤ μ(X+Y) fz − s1 (Y fx − μ m'_x) − s2 (X fy − μ m'_y)
+          rows.add("yaw_min_" + std::to_string(yaw++), K::Yaw, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
+                       {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, -s1 * mu}, {Fz, s1 * mu * cy},
+                       {Fy, s2 * X}, {My, -s2 * mu}, {Fz, -s2 * mu * cx}});
+        }
+      break;
+    }
+  }
+  return out;
+}
 
 ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
                                       const Eigen::Ref<const Eigen::MatrixXd>& J1,
@@ -92,58 +147,17 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   for (int i = 0; i < nc; ++i) wrenchToWorld(contacts[i].pose, p.balance.middleCols<6>(6 * i));
   p.balanceTarget = balanceWrench;
 
-  const int perContact = rowsPerContact(settings);
-  p.inequality.resize(perContact * nc, 6 * nc);
+  const int perContact = contactModelRowCount(settings);
+  p.inequality.setZero(perContact * nc, 6 * nc);
   p.inequalityBound.resize(perContact * nc);
-  RowWriter rows{p.inequality, p.inequalityBound, p.rowNames, contacts};
   for (const ContactSpec& c : contacts) p.contactNames.push_back(c.name);
   for (int i = 0; i < nc; ++i) {
-    const ContactSpec& c = contacts[i];
-    rows.add("fz_min", i, {{Fz, -1.0}}, -c.minNormalForce);  // fz ≥ f_min
-    rows.add("cop_x_max", i, {{My, -1.0}, {Fz, -c.xMax}});    // −m_y ≤ x_max fz
-    rows.add("cop_x_min", i, {{My, 1.0}, {Fz, c.xMin}});      // x_min fz ≤ −m_y
-    rows.add("cop_y_max", i, {{Mx, 1.0}, {Fz, -c.yMax}});     // m_x ≤ y_max fz
-    rows.add("cop_y_min", i, {{Mx, -1.0}, {Fz, c.yMin}});     // y_min fz ≤ m_x
-    switch (settings.model) {
-      case ContactModel::Report:
-        p.cones.push_back({6 * i, c.friction});
-        break;
-      case ContactModel::Pyramid: {
-        const int k = settings.pyramidFacets;
-        const double inscribed = c.friction * std::cos(std::numbers::pi / k);
-        for (int f = 0; f < k; ++f) {
-          const double theta = 2.0 * std::numbers::pi * f / k;
-          rows.add("facet_" + std::to_string(f), i, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
-        }
-        break;
-      }
-      case ContactModel::WrenchCone: {
-        // About the rectangle's centre (cx, cy): m'_x = m_x − cy fz, m'_y = m_y + cx fz,
-        // m'_z = m_z − cx fy + cy fx. With μ̃ = μ/√2 the pyramid |fx|, |fy| ≤ μ̃ fz is
-        // inscribed in the circular cone (Caron et al. §III), so the wrench cone admits
-        // nothing the report model forbids and forbids, besides, the yaw slip.
-        const double mu = c.friction / std::numbers::sqrt2;
-        const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
-        const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
-        rows.add("fx_max", i, {{Fx, 1.0}, {Fz, -mu}});
-        rows.add("fx_min", i, {{Fx, -1.0}, {Fz, -mu}});
-        rows.add("fy_max", i, {{Fy, 1.0}, {Fz, -mu}});
-        rows.add("fy_min", i, {{Fy, -1.0}, {Fz, -mu}});
-        int yaw = 0;
-        for (double s1 : {-1.0, 1.0})
-          for (double s2 : {-1.0, 1.0}) {
-            // m'_z ≤ μ(X+Y) fz − s1 (Y fx + μ m'_x) − s2 (X fy + μ m'_y)
-            rows.add("yaw_max_" + std::to_string(yaw), i, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
-                         {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, s1 * mu}, {Fz, -s1 * mu * cy},
-                         {Fy, s2 * X}, {My, s2 * mu}, {Fz, s2 * mu * cx}});
-            // −m'_z ≤ μ(X+Y) fz − s1 (Y fx − μ m'_x) − s2 (X fy − μ m'_y)
-            rows.add("yaw_min_" + std::to_string(yaw++), i, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
-                         {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, -s1 * mu}, {Fz, s1 * mu * cy},
-                         {Fy, s2 * X}, {My, -s2 * mu}, {Fz, -s2 * mu * cx}});
-          }
-        break;
-      }
-    }
+    const ContactSpec& c = contacts[static_cast<std::size_t>(i)];
+    const ContactModelRows rows = contactModelRows(c, settings);
+    p.inequality.block(perContact * i, 6 * i, perContact, 6) = rows.rows;
+    p.inequalityBound.segment(perContact * i, perContact) = rows.bound;
+    for (const std::string& name : rows.names) p.rowNames.push_back(c.name + "." + name);
+    if (settings.model == ContactModel::Report) p.cones.push_back({6 * i, c.friction});
   }
   return p;
 }

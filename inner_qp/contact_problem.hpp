@@ -53,6 +53,24 @@ struct FrictionCone {
   double friction = 0.0;
 };
 
+/// What a contact-model row bounds (results group violations by it).
+enum class ContactRowKind { NormalForce, CenterOfPressure, Friction, Yaw };
+
+/// One contact's linear rows in its own frame, rows · F ≤ bound with F = (f, m) in C: the
+/// model's rows of assembleContactProblem (the report model's friction cone, a second-order
+/// cone, is not among them). The single-level outer formulations hold the same rows on
+/// their wrench variables (outer_nlp/contact_admissibility.hpp).
+struct ContactModelRows {
+  Eigen::Matrix<double, Eigen::Dynamic, 6> rows;
+  Eigen::VectorXd bound;
+  std::vector<std::string> names;     ///< fz_min, cop_x_max, …, facet_<k> or fx_max, …, yaw_min_3
+  std::vector<ContactRowKind> kinds;
+};
+/// Rows a contact has under the model: 5 (report), 5 + facets (pyramid), 17 (wrench cone).
+int contactModelRowCount(const ContactProblemSettings& settings);
+/// Throws InputError for fewer than 3 pyramid facets.
+ContactModelRows contactModelRows(const ContactSpec& contact, const ContactProblemSettings& settings);
+
 /// Problem data, sized once per contact set and overwritten per sample.
 struct ContactProblem {
   int contactCount = 0;

@@ -11,7 +11,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const DynamicsModel& model,
-                                           const SupportContactRows& support, double instant)
+                                           const ContactAdmissibilityRows& support, double instant)
     : scenario_(scenario),
       model_(model),
       support_(support),
@@ -23,7 +23,7 @@ ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const Dynam
       taskDq_(3, model.jointCount()),
       taskDv_(3, model.jointCount()) {
   if (scenario.contactConstraints)
-    for (int c = 0; c < 6; ++c) rowTask_.push_back(-1), rowComponent_.push_back(c);
+    for (int c = 0; c < support.rowCount(); ++c) rowTask_.push_back(-1), rowComponent_.push_back(c);
   for (std::size_t t = 0; t < scenario.tasks.size(); ++t) {
     const TaskSpec& task = scenario.tasks[t];
     if (taskReadsVelocity(task.kind)) continue;
@@ -40,6 +40,7 @@ ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const Dynam
     for (int j = 0; j < jointCount_; ++j) jacobianRows_[r * jointCount_ + j] = r, jacobianColumns_[r * jointCount_ + j] = j;
   rows_.setZero(rows);
   rowsByQ_.setZero(rows, jointCount_);
+  rowsByWrench_.setZero(support.rowCount(), 6);
 }
 
 void ConfigurationProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
@@ -72,10 +73,9 @@ void ConfigurationProblem::evaluate(const Eigen::VectorXd& q) {
   inverseDynamicsDerivatives(model_, data_, derivatives_, q, zero_, zero_);
   int row = 0;
   if (scenario_.contactConstraints) {
-    Eigen::Matrix<double, 6, 6> rowsByWrench;
-    support_.evaluate(data_.referenceWrench, rows_.head<6>(), rowsByWrench);
-    rowsByQ_.topRows<6>().noalias() = rowsByWrench * derivatives_.dwrenchDq;
-    row = 6;
+    row = support_.rowCount();
+    support_.evaluate(data_.referenceWrench, rows_.head(row), rowsByWrench_);
+    rowsByQ_.topRows(row).noalias() = rowsByWrench_ * derivatives_.dwrenchDq;
   }
   for (const int t : tasks_) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(t)];
@@ -129,7 +129,7 @@ void ConfigurationProblem::jacobianValues(const Eigen::VectorXd& q, Eigen::Vecto
 
 std::string ConfigurationProblem::rowName(int row) const {
   const int t = rowTask_[static_cast<std::size_t>(row)], c = rowComponent_[static_cast<std::size_t>(row)];
-  if (t < 0) return scenario_.support.name + " " + SupportContactRows::rowName(c);
+  if (t < 0) return scenario_.support.name + " " + support_.rowName(c);
   return "task '" + scenario_.tasks[static_cast<std::size_t>(t)].name + "' component " + "xyz"[c];
 }
 

@@ -8,7 +8,7 @@
 // to the gravity effects"), so the winding carries Γem = max(|Γ/N| − Γ_d, 0) and
 //   P_static = Σ_j (R_j / K_j²) max(|Γ_j / N_j| − Γ_d,j, 0)²,
 // which is C¹ (its slope is continuous at |Γ/N| = Γ_d). Constraints: joint limits (bounds),
-// the support contact rows of W0 (support_contact.hpp), position, orientation and
+// the support contact rows of W0 (contact_admissibility.hpp), position, orientation and
 // centre-of-mass tasks at that instant (velocity tasks are zero-velocity-free: ignored).
 
 #include <Eigen/Core>
@@ -17,7 +17,7 @@
 #include "core/dynamics_derivatives.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
-#include "outer_nlp/support_contact.hpp"
+#include "outer_nlp/contact_admissibility.hpp"
 #include "outer_nlp/task_kinematics.hpp"
 
 namespace mcopt {
@@ -25,7 +25,7 @@ namespace mcopt {
 class ConfigurationProblem final : public NlpProblem {
  public:
   /// instant: time of the posture in the motion [s] (0 for the start, T for the end).
-  ConfigurationProblem(const Scenario& scenario, const DynamicsModel& model, const SupportContactRows& support,
+  ConfigurationProblem(const Scenario& scenario, const DynamicsModel& model, const ContactAdmissibilityRows& support,
                        double instant);
 
   int variableCount() const override { return jointCount_; }
@@ -48,7 +48,7 @@ class ConfigurationProblem final : public NlpProblem {
 
   const Scenario& scenario_;
   const DynamicsModel& model_;
-  const SupportContactRows& support_;
+  const ContactAdmissibilityRows& support_;
   int jointCount_;
   std::vector<int> tasks_;           ///< scenario tasks that hold at the instant
   std::vector<int> rowTask_;         ///< −1 for the contact rows, else the task
@@ -58,6 +58,7 @@ class ConfigurationProblem final : public NlpProblem {
   DynamicsData data_;
   DynamicsDerivatives derivatives_;
   TaskWorkspace taskWorkspace_;
+  ContactRowsByWrench rowsByWrench_;
   Eigen::VectorXd zero_, cachedQ_, rows_;
   Eigen::MatrixXd rowsByQ_;
   Eigen::Matrix3Xd taskDq_, taskDv_;

@@ -75,6 +75,17 @@ RigidTransform supportPose(const DynamicsModel& model, const ContactSurface& sur
   return framePose(model, data, surface.frame) * surface.placement;
 }
 
+/// The row kind a contact-model row is reported under.
+ConstraintKind contactConstraintKind(ContactRowKind kind) {
+  switch (kind) {
+    case ContactRowKind::NormalForce: return ConstraintKind::ContactUnilateral;
+    case ContactRowKind::CenterOfPressure: return ConstraintKind::ContactCop;
+    case ContactRowKind::Friction: return ConstraintKind::ContactFriction;
+    case ContactRowKind::Yaw: return ConstraintKind::ContactYaw;
+  }
+  return ConstraintKind::ContactFriction;
+}
+
 }  // namespace
 
 const char* constraintKindName(ConstraintKind kind) {
@@ -84,6 +95,7 @@ const char* constraintKindName(ConstraintKind kind) {
     case ConstraintKind::ContactUnilateral: return "contact_unilateral";
     case ConstraintKind::ContactFriction: return "contact_friction";
     case ConstraintKind::ContactCop: return "contact_cop";
+    case ConstraintKind::ContactYaw: return "contact_yaw";
     case ConstraintKind::InnerFeasibility: return "inner_feasibility";
     case ConstraintKind::Closure: return "closure";
     case ConstraintKind::Task: return "task";
@@ -98,7 +110,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       parametrization_(scenario.robot.jointCount(), scenario.controlPoints),
       samples_(parametrization_, nlpSampleTimes(scenario)),
       taskSamples_(parametrization_, taskInstants(scenario, taskOfInstant_)),
-      support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm()),
+      support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm(),
+               scenario.inner.problem),
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
@@ -122,11 +135,11 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
     throw InputError("motion problem: the torque-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());
-  outputs_.joints = jointCount_, outputs_.contacts = contacts;
+  outputs_.joints = jointCount_, outputs_.contacts = contacts, outputs_.rowsPerContact = support_.rowCount();
   forceStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
   for (const EnvironmentContact& c : scenario_.contacts) {
     windows_.push_back({c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)});
-    contactRows_.emplace_back(c.surface, RigidTransform{}, weight_);
+    contactRows_.emplace_back(c.surface, RigidTransform{}, weight_, scenario_.inner.problem);
   }
   // With the reference contact alone the wrench is W0 whatever the formulation (§5).
   bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
@@ -157,7 +170,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     }
   }
 
-  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model_, contacts));
+  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model_, contacts, outputs_.rowsPerContact));
   const int outputs = outputs_.size();
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   for (int s = 0; s < samples_.sampleCount(); ++s) {
@@ -289,17 +302,16 @@ void MotionProblem::buildStructure() {
         sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
                 true);
     if (scenario_.contactConstraints && explicitForces) {
-      for (int c = 0; c < 6; ++c)
-        sampleRow(c == 0 ? ConstraintKind::ContactUnilateral : c == 1 ? ConstraintKind::ContactFriction : ConstraintKind::ContactCop,
-                  c, false, s, outputs_.referenceRow(c), 1.0, allJoints_, true);
+      const int perContact = outputs_.rowsPerContact;
+      for (int c = 0; c < perContact; ++c)
+        sampleRow(contactConstraintKind(support_.rowKind(c)), c, false, s, outputs_.referenceRow(c), 1.0, allJoints_, true);
       // An environment contact's rows read its own wrench, in its own frame: only its variables.
       const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
       int firstColumn = 0;
       for (int i = 0; i < contacts; ++i) {
         const int width = 6 * static_cast<int>(forces_->terms(i, s).size());
-        for (int c = 0; c < 6 && width > 0; ++c) {
-          rows_.push_back({c == 0 ? ConstraintKind::ContactUnilateral : c == 1 ? ConstraintKind::ContactFriction : ConstraintKind::ContactCop,
-                           6 * (i + 1) + c, s, outputs_.contactRow(i, c)});
+        for (int c = 0; c < perContact && width > 0; ++c) {
+          rows_.push_back({contactConstraintKind(support_.rowKind(c)), perContact * (i + 1) + c, s, outputs_.contactRow(i, c)});
           for (int l = firstColumn; l < firstColumn + width; ++l)
             entry(b.forceColumns[static_cast<std::size_t>(l)], {Source::Force, false, s, outputs_.contactRow(i, c), l, 1.0});
         }
@@ -339,10 +351,11 @@ std::string MotionProblem::rowName(int row) const {
       break;
     case ConstraintKind::ContactUnilateral:
     case ConstraintKind::ContactFriction:
-    case ConstraintKind::ContactCop: {
-      const int contact = r.detail / 6;
+    case ConstraintKind::ContactCop:
+    case ConstraintKind::ContactYaw: {
+      const int contact = r.detail / outputs_.rowsPerContact;
       name << (contact == 0 ? scenario_.support.name : scenario_.contacts[static_cast<std::size_t>(contact - 1)].surface.name)
-           << " " << SupportContactRows::rowName(r.detail % 6);
+           << " " << support_.rowName(r.detail % outputs_.rowsPerContact);
       break;
     }
     case ConstraintKind::InnerFeasibility: name << "inner problem feasibility (balance slack)"; break;
@@ -398,6 +411,7 @@ void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& up
       case ConstraintKind::InnerFeasibility: lower[r] = -kInf, upper[r] = 0.0; break;
       case ConstraintKind::ContactFriction:
       case ConstraintKind::ContactCop:
+      case ConstraintKind::ContactYaw:
       case ConstraintKind::Epigraph: lower[r] = 0.0, upper[r] = kInf; break;
       case ConstraintKind::Closure:
       case ConstraintKind::Task: {
@@ -516,7 +530,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
       wrenchToWorld(frame, toWorld);
       w.torque.noalias() -= toTorque * F;
       reference.noalias() -= toWorld * F;
-      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment<6>(outputs_.contactRow(i, 0)),
+      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment(outputs_.contactRow(i, 0), outputs_.rowsPerContact),
                                                         w.rowsByWrench[static_cast<std::size_t>(i)]);
       if (derivatives) {
         wrenchMapDerivatives(model, w.data, frame, F, w.dWorld, w.dTorque);
@@ -524,19 +538,22 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
         w.referenceDq -= w.dWorld;
       }
     }
-    Eigen::Matrix<double, 6, 6> rowsByReference;
+    const int perContact = outputs_.rowsPerContact;
+    ContactRowsByWrench& rowsByReference = w.rowsByReference;
     if (derivatives)
-      support_.evaluate(reference, b.y.segment<6>(outputs_.referenceRow(0)), rowsByReference);
+      support_.evaluate(reference, b.y.segment(outputs_.referenceRow(0), perContact), rowsByReference);
     else
-      support_.evaluate(reference, b.y.segment<6>(outputs_.referenceRow(0)));
+      support_.evaluate(reference, b.y.segment(outputs_.referenceRow(0), perContact));
     b.wrenches.head<6>() = support_.contactWrench(reference);
     if (derivatives) {
       b.dyDq.topRows(n) = w.torqueDq;
       b.dyDv.topRows(n) = d.dtauDv;
       b.dyDa.topRows(n) = d.dtauDa;
-      b.dyDq.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * w.referenceDq;
-      b.dyDv.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * d.dwrenchDv;
-      b.dyDa.middleRows<6>(outputs_.referenceRow(0)).noalias() = rowsByReference * d.dwrenchDa;
+      // Small products of run-time sizes: coefficient-based (lazyProduct), as Eigen's blocked
+      // product may take heap workspace for them.
+      b.dyDq.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(w.referenceDq);
+      b.dyDv.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(d.dwrenchDv);
+      b.dyDa.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(d.dwrenchDa);
       // Force columns: ∂Γ/∂F_i = −J1_i, ∂rows_ref/∂F_i = −(∂rows/∂W_ref) wrenchToWorld_i,
       // ∂rows_i/∂F_i, each times the term's weight.
       int column = 0;
@@ -544,8 +561,9 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
         for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
           const auto i_ = static_cast<std::size_t>(i);
           b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
-          b.dyDz.block(outputs_.referenceRow(0), column, 6, 6).noalias() = -t.weight * rowsByReference * w.toWorld[i_];
-          b.dyDz.block(outputs_.contactRow(i, 0), column, 6, 6) = t.weight * w.rowsByWrench[i_];
+          b.dyDz.block(outputs_.referenceRow(0), column, perContact, 6).noalias() =
+              -t.weight * rowsByReference.lazyProduct(w.toWorld[i_]);
+          b.dyDz.block(outputs_.contactRow(i, 0), column, perContact, 6) = t.weight * w.rowsByWrench[i_];
           column += 6;
         }
     }

@@ -50,15 +50,16 @@
 #include "outer_nlp/contact_force_parametrization.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
-#include "outer_nlp/support_contact.hpp"
+#include "outer_nlp/contact_admissibility.hpp"
 #include "outer_nlp/task_kinematics.hpp"
 
 namespace mcopt {
 
 enum class ConstraintKind {
-  VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, InnerFeasibility, Closure, Task, Epigraph
+  VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, ContactYaw, InnerFeasibility, Closure, Task,
+  Epigraph
 };
-inline constexpr int kConstraintKindCount = 9;
+inline constexpr int kConstraintKindCount = 10;
 const char* constraintKindName(ConstraintKind kind);
 
 class BilevelSample;
@@ -120,7 +121,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<bool> torquesBelow(const Eigen::VectorXd& x, double fraction);
   int omittedTorqueRowCount() const;
   ~MotionProblem() override;
-  const SupportContactRows& support() const { return support_; }
+  const ContactAdmissibilityRows& support() const { return support_; }
 
   const Scenario& scenario() const { return scenario_; }
   const DynamicsModel& model() const { return model_; }
@@ -205,12 +206,13 @@ class MotionProblem final : public NlpProblem {
   /// Output index of each per-sample quantity (rows of a sample's evaluation).
   struct SampleOutputs {
     int joints = 0, contacts = 0;  ///< n, environment contacts
+    int rowsPerContact = 6;        ///< the contact model's admissibility rows (contact_admissibility.hpp)
     int torque(int j) const { return j; }
     int referenceRow(int c) const { return joints + c; }
-    int contactRow(int contact, int c) const { return joints + 6 + 6 * contact + c; }
-    int infeasibility() const { return joints + 6 + 6 * contacts; }
-    int power(int j) const { return joints + 7 + 6 * contacts + j; }
-    int size() const { return 2 * joints + 7 + 6 * contacts; }
+    int contactRow(int contact, int c) const { return joints + rowsPerContact * (1 + contact) + c; }
+    int infeasibility() const { return joints + rowsPerContact * (1 + contacts); }
+    int power(int j) const { return infeasibility() + 1 + j; }
+    int size() const { return power(joints); }
   };
 
  private:
@@ -297,7 +299,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<std::array<double, 2>> windows_;   ///< per environment contact, normalised
   std::unique_ptr<ContactForceParametrization> forces_;
   std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
-  std::vector<SupportContactRows> contactRows_;  ///< per environment contact, on its own wrench
+  std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
   std::vector<int> allJoints_;
@@ -305,7 +307,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<std::vector<int>> taskJoints_;     ///< per task instant: joints that move the task's body
   struct VelocityRow { int joint, first, second; double scale; };  ///< 3 (x_second − x_first)/(T Δu) → scale = 3/Δu
   std::vector<VelocityRow> velocityRows_;
-  SupportContactRows support_;
+  ContactAdmissibilityRows support_;
   double weight_ = 0.0;                   ///< m g [N]
 
   std::vector<Row> rows_;

@@ -9,19 +9,22 @@
 #include "core/dynamics_derivatives.hpp"
 #include "core/dynamics_model.hpp"
 #include "core/spatial.hpp"
+#include "outer_nlp/contact_admissibility.hpp"
 #include "outer_nlp/task_kinematics.hpp"
 
 namespace mcopt {
 
 /// MotionProblem's per-thread buffers, sized once (the per-sample path allocates nothing).
 struct MotionWorkspace {
-  MotionWorkspace(const DynamicsModel& model, int contacts) : data(model), derivatives(model), task(model) {
+  MotionWorkspace(const DynamicsModel& model, int contacts, int rowsPerContact)
+      : data(model), derivatives(model), task(model) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
     torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
     toTorque.assign(static_cast<std::size_t>(contacts), WrenchToTorque::Zero(n, 6));
     toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
-    rowsByWrench.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
+    rowsByWrench.assign(static_cast<std::size_t>(contacts), ContactRowsByWrench::Zero(rowsPerContact, 6));
+    rowsByReference.setZero(rowsPerContact, 6);
   }
   DynamicsData data;
   DynamicsDerivatives derivatives;
@@ -31,7 +34,8 @@ struct MotionWorkspace {
   Eigen::Matrix<double, 6, Eigen::Dynamic> referenceDq, dWorld;
   std::vector<WrenchToTorque> toTorque;  ///< per environment contact, J1_i
   std::vector<Matrix6> toWorld;          ///< per environment contact, wrenchToWorld_i
-  std::vector<Matrix6> rowsByWrench;     ///< per environment contact, ∂rows_i/∂F_i
+  std::vector<ContactRowsByWrench> rowsByWrench;  ///< per environment contact, ∂rows_i/∂F_i
+  ContactRowsByWrench rowsByReference;           ///< ∂rows_ref/∂W_ref
 };
 
 }  // namespace mcopt
