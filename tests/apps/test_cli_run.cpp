@@ -363,6 +363,7 @@ TEST_CASE("run: a Hessian-only stage that ends optimal ends the run", "[cli][run
     if (kUnderSanitizers) continue;
     const auto scenario = kickVariant(dir, [&](YAML::Node& root) {
       root["samples"] = 12;
+      root["hessian"] = "sample-differences";  // the stage differs in its Hessian alone
       root["continuation"] = YAML::Load(sameProblem ? "[{hessian: gauss-newton}]"
                                                     : "[{hessian: gauss-newton, friction_sharpness: 0.5, max_iterations: 3}]");
     });
