@@ -65,6 +65,7 @@ TEST_CASE("run: Ipopt's derivative checker finds no error on the bundled scenari
     root["solver"]["derivative_test"] = "first-order";
     root["solver"]["derivative_test_perturbation"] = 1e-7;
     root["solver"]["print_level"] = 5;
+    root["continuation"] = YAML::Load("[]");  // one stage, stopped at iteration 0
   });
   for (const char* initialisation : {"off", "on"}) {
     if (kUnderSanitizers && std::string(initialisation) == "on") continue;
@@ -81,7 +82,7 @@ TEST_CASE("run: result files, their fields, and torques that mcopt dynamics repr
   const int samples = kUnderSanitizers ? 20 : 40;
   const auto scenario = kickVariant(dir, [&](YAML::Node& root) {
     root["samples"] = samples;
-    if (kUnderSanitizers) root["hessian"] = "limited-memory";
+    if (kUnderSanitizers) root["hessian"] = "limited-memory", root["continuation"] = YAML::Load("[]");
   });
   const auto out = dir.path() / "out";
   const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 15");
@@ -129,6 +130,7 @@ TEST_CASE("run: an interrupted run writes its last iterate and exits non-zero", 
   const auto scenario = kickVariant(dir, [](YAML::Node& root) {
     root["solver"]["max_iter"] = 100000;
     root["hessian"] = "limited-memory";  // short iterations: several are done when the signal comes
+    root["continuation"] = YAML::Load("[]");  // one stage
   });
   const auto out = dir.path() / "out";
   // SIGINT once Ipopt iterates (configuration optimisation off to get there fast).
@@ -149,6 +151,7 @@ TEST_CASE("run: a run killed outright leaves its latest checkpoint, the iterate 
     root["samples"] = 40;
     root["solver"]["max_iter"] = 100000;
     root["hessian"] = "limited-memory";
+    root["continuation"] = YAML::Load("[]");  // one stage: the checkpoint's iteration count is the run's
   });
   const auto out = dir.path() / "out";
   const std::string run = std::string(MCOPT_EXECUTABLE) + " run " + test::quoted(scenario) +

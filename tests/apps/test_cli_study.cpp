@@ -32,7 +32,8 @@ using mcopt::test::kUnderSanitizers;
 std::filesystem::path fourCaseSweep(const test::TempDir& dir, const std::string& extra = "", int longIterations = 100,
                                     bool neverConverged = false) {
   return dir.write("sweep.yaml", "description: four short kicks\nscenario: " + (test::sourceDir() / "scenarios/hrp2_kick.yaml").string() +
-                                     "\nset:\n  samples: 10\n  initialisation.configuration_optimisation: false\n" +
+                                     "\nset:\n  samples: 10\n  initialisation.configuration_optimisation: false\n"
+                                     "  hessian: gauss-newton\n  continuation: []\n" +  // one stage: max_iter bounds the run
                                      (neverConverged ? "  solver.tol: 1.0e-14\n  solver.acceptable_iter: 0\n" : "") +
                                      "vary:\n  - {field: solver.max_iter, values: [15, " + std::to_string(longIterations) + "]}\n"
                                      "  - {field: 'tasks[kick].target[0]', values: [0.8, 1.0]}\n"

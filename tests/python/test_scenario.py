@@ -18,8 +18,12 @@ UNTIMED = ("timings", "seconds", "elapsed_seconds", "scenario", "contact_surface
 
 
 def small_kick(samples=12):
+    """The kick at fewer samples, one stage: its Gauss–Newton Hessian alone, so that an
+    iteration limit bounds the whole run."""
     s = mcopt.Scenario(KICK)
     s["samples"] = samples
+    s["hessian"] = "gauss-newton"
+    s["continuation"] = []
     return s
 
 
