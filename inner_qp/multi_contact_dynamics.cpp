@@ -32,12 +32,15 @@ void innerObjectiveTermDerivatives(const ActuatorSet& actuators, const Eigen::Re
   }
 }
 
+ContactSpec contactSpec(const ContactSurface& s, const RigidTransform& pose) {
+  return {s.name, pose, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0};
+}
+
 SampleProblem::SampleProblem(const DynamicsModel& model, const std::vector<ContactSurface>& contacts,
                              const ContactProblemSettings& settings) {
   const int n = model.jointCount(), nc = static_cast<int>(contacts.size());
   std::vector<ContactSpec> specs;
-  for (const ContactSurface& s : contacts)
-    specs.push_back({s.name, RigidTransform{}, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0});
+  for (const ContactSurface& s : contacts) specs.push_back(contactSpec(s));
   problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, 6 * nc), Eigen::VectorXd::Zero(n), Vector6::Zero(),
                                    Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n), settings);
   wrenchToTorque.setZero(n, 6 * nc);

@@ -25,6 +25,10 @@ struct MultiContactSettings {
   std::string solverName = "active-set";  ///< active-set, slsqp or ipopt
 };
 
+/// A robot's contact surface as an inner-problem contact (f_min = 0), at `pose` in the world
+/// (the identity until the sample sets it).
+ContactSpec contactSpec(const ContactSurface& surface, const RigidTransform& pose = RigidTransform{});
+
 /// One sample's inner problem, built from a Newton–Euler pass (formulation.md §5, §7): the
 /// contact frames, wrenchToTorque J1 (n × 6nc), the objective's per-joint terms, the balance
 /// at W0. Sized once; update() allocates nothing.

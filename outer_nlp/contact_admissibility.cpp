@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "inner_qp/multi_contact_dynamics.hpp"
+
 namespace mcopt {
 
 ContactAdmissibilityRows::ContactAdmissibilityRows(const ContactSurface& surface, const RigidTransform& pose,
@@ -20,11 +22,7 @@ ContactAdmissibilityRows::ContactAdmissibilityRows(const ContactSurface& surface
   }
   // The inner problem's rows with f_min = 0: row 0 is then f_z itself, bounded by f_min as
   // the report model's is.
-  ContactSpec spec;
-  spec.name = surface.name;
-  spec.friction = surface.friction;
-  spec.xMin = surface.xMin, spec.xMax = surface.xMax, spec.yMin = surface.yMin, spec.yMax = surface.yMax;
-  const ContactModelRows rows = contactModelRows(spec, model);
+  const ContactModelRows rows = contactModelRows(contactSpec(surface), model);
   linearByWrench_ = -rows.rows * toContact_;
   linearOffset_ = rows.bound;
   names_ = rows.names;
