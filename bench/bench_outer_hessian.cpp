@@ -67,7 +67,8 @@ void registerOuterHessianBenchmarks() {
     benchmark::RegisterBenchmark((std::string("OuterGradient/weight_shift/") + toString(forces)).c_str(), outerGradient,
                                  weightShift(forces, "active-set"))
         ->Unit(benchmark::kMillisecond);
-  for (const HessianOption option : {HessianOption::FiniteDifferences, HessianOption::SampleDifferences})
+  for (const HessianOption option : {HessianOption::FiniteDifferences, HessianOption::SampleDifferences,
+                                     HessianOption::GaussNewton, HessianOption::Exact})
     benchmark::RegisterBenchmark((std::string("OuterHessian/Kick100/hrp2/") + toString(option)).c_str(), outerHessian, option)
         ->Unit(benchmark::kMillisecond);
 }

@@ -44,6 +44,9 @@ class ContactAdmissibilityRows {
   /// "f_z", "friction cone", "CoP x ≥ x_min", … (report) or the inner problem's row names.
   const std::string& rowName(int row) const { return names_[static_cast<std::size_t>(row)]; }
 
+  /// Whether a row is quadratic in W (the report model's friction cone); the others are linear.
+  /// The exact Hessian's stencils take the degree from it (motion_hessian.cpp).
+  bool hasQuadraticRows() const { return smoothCone_; }
   /// W: world axes, about the world origin (or C's own wrench with the identity pose).
   /// rows: rowCount() values; allocation-free.
   void evaluate(const Vector6& wrench, Eigen::Ref<Eigen::VectorXd> rows) const;

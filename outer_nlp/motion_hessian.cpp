@@ -14,6 +14,19 @@
 // derivatives instead (sampleGaussNewtonHessian: no extra evaluation; a model, not the
 // Hessian). The duration's column (when it is free) is a forward difference of the whole
 // gradient: T scales every sample's velocity and acceleration and the trapezoid weights.
+//
+// `exact` (sampleExactHessian) is the Hessian itself: the gauss-newton terms (the energy's
+// and the epigraph's exact curvature in the outputs) plus Σ_o w_o ∇²y_o, the outputs' own
+// curvature with each output's weight w_o held at the point. Along one state component the
+// weighted output gradient Σ_o w_o ∇y_o is a polynomial of known degree (in q̇, q̈, a force
+// variable) or a trigonometric polynomial (in a revolute joint's angle), so a stencil of
+// that degree differentiates it exactly (derivative_stencil.hpp). The duration's row and
+// column follow by the chain rule from z_s = (B0 x, B1 x / T, B2 x / T²) and the objective's
+// weight ∝ T:
+//   ∂²L/∂x∂T = Bᵀ (H_s u + ĝ + c ∇E),  ∂²L/∂T² = uᵀ H_s u + gᵀ z'' + 2 c ∇E·u,
+// u = ∂z/∂T = (0, −q̇/T, −2q̈/T), z'' = (0, 2q̇/T², 6q̈/T²), ĝ = (0, −g_q̇/T, −2g_q̈/T), g the
+// sample's gradient in z, c ∇E its objective's per unit of T; the velocity-limit rows
+// (∝ 1/T) add theirs.
 #include <omp.h>
 
 #include <Eigen/Eigenvalues>
@@ -36,7 +49,7 @@ inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::ab
 void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                       const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
   if (scenario_.hessian == HessianOption::SampleDifferences || scenario_.hessian == HessianOption::ConvexSampleDifferences ||
-      scenario_.hessian == HessianOption::GaussNewton)
+      scenario_.hessian == HessianOption::GaussNewton || scenario_.hessian == HessianOption::Exact)
     sampleDifferencesHessian(x, objectiveFactor, multipliers, values);
   else
     NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
@@ -50,13 +63,64 @@ void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::
   if (scenario_.energyForm == EnergyForm::SmoothMaximum)
     for (int j = 0; j < n; ++j)
       h.weights[outputs_.power(j)] += objectiveWeight * smoothMaximumSlope(b.y[outputs_.power(j)], scenario_.smoothing);
-  gradient.segment(0, n).noalias() = b.dyDq.transpose() * h.weights;
-  gradient.segment(n, n).noalias() = b.dyDv.transpose() * h.weights;
-  gradient.segment(2 * n, n).noalias() = b.dyDa.transpose() * h.weights;
+  outputGradient(b, h.weights, gradient);
   // The regularisation w Σ q̈² (formulation.md §10).
   gradient.segment(2 * n, n) += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration;
+}
+
+void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights,
+                                   Eigen::Ref<Eigen::VectorXd> gradient) const {
+  const int n = jointCount_;
+  gradient.segment(0, n).noalias() = b.dyDq.transpose() * weights;
+  gradient.segment(n, n).noalias() = b.dyDv.transpose() * weights;
+  gradient.segment(2 * n, n).noalias() = b.dyDa.transpose() * weights;
   const Eigen::Index forces = gradient.size() - 3 * n;
-  if (forces > 0) gradient.tail(forces).noalias() = b.dyDz.leftCols(forces).transpose() * h.weights;
+  if (forces > 0) gradient.tail(forces).noalias() = b.dyDz.leftCols(forces).transpose() * weights;
+}
+
+void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                                       double objectiveWeight, double T, ThreadWorkspace& w, HessianWorkspace& h,
+                                       SampleBlock& probe) {
+  const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
+  // The energy's and the epigraph's curvature in the outputs (P in Γ, q̇, q̈; σ in P) ...
+  sampleGaussNewtonHessian(b, multipliers, objectiveWeight, h);
+  // ... and the outputs' own: each output's weight at this point is its multiplier, plus on
+  // Γ_j the power's slope times ∂P/∂Γ (P's own curvature is in the terms above).
+  const bool smooth = scenario_.energyForm == EnergyForm::SmoothMaximum;
+  h.fixedWeights = multipliers;
+  for (int j = 0; j < n; ++j) {
+    const double P = b.y[outputs_.power(j)];
+    const double slope =
+        multipliers[outputs_.power(j)] + (smooth ? objectiveWeight * smoothMaximumSlope(P, scenario_.smoothing) : 0.0);
+    const MotorPowerDerivatives p =
+        motorPowerDerivatives(scenario_.actuators.joints[static_cast<std::size_t>(j)], scenario_.actuators.frictionSharpness,
+                              b.y[outputs_.torque(j)], b.velocity[j], b.acceleration[j]);
+    h.fixedWeights[outputs_.torque(j)] += slope * p.dTorque;
+    h.fixedWeights[outputs_.power(j)] = 0.0;
+  }
+  samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+  auto H = h.stateHessian.topLeftCorner(d, d);
+  auto column = h.column.head(d), gradient = h.gradient.head(d);
+  for (int c = 0; c < d; ++c) {
+    double* component = c < n           ? &w.q[c]
+                        : c < 2 * n     ? &w.v[c - n]
+                        : c < 3 * n     ? &w.a[c - 2 * n]
+                                        : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
+    const DerivativeStencil& stencil = c < n       ? exactStencils_.angle
+                                       : c < 2 * n ? exactStencils_.velocity
+                                       : c < 3 * n ? exactStencils_.acceleration
+                                                   : exactStencils_.force;
+    const double saved = *component;
+    column.setZero();
+    for (int m = 0; m < stencil.size(); ++m) {
+      *component = saved + stencil.offsets[static_cast<std::size_t>(m)];
+      sampleOutputs(s, h.probeX, true, w, probe);
+      outputGradient(probe, h.fixedWeights, gradient);
+      column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
+    }
+    *component = saved;
+    H.col(c) += column;
+  }
 }
 
 void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
@@ -146,10 +210,12 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     for (HessianWorkspace& h : hessianWorkspaces_) {
       h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
+      h.fixedWeights.setZero(outputs), h.zeroWeights.setZero(outputs), h.column.setZero(largest);
+      h.objectiveGradient.setZero(largest), h.stateByDuration.setZero(largest), h.durationRow.setZero(largest);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
-    for (LocalHessian& l : localHessians_)
-      l.values.setZero(largestLocal, largestLocal), l.columns.reserve(static_cast<std::size_t>(largestLocal));
+    for (LocalHessian& l : localHessians_)  // + 1: the duration's row and column (exact option)
+      l.values.setZero(largestLocal + 1, largestLocal + 1), l.columns.reserve(static_cast<std::size_t>(largestLocal + 1));
     probes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
@@ -172,6 +238,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // Writes Bᵀ H B into the slot's LocalHessian: B maps the local spline parameters (k per joint, their
     // weights in q, q̇ = (1/T) dq/du, q̈ = (1/T²) d²q/du²) and the force columns to the state.
     const bool convex = scenario_.hessian == HessianOption::ConvexSampleDifferences;
+    const bool exact = scenario_.hessian == HessianOption::Exact, freeDuration = durationIsFree();
     // Symmetrises the leading d × d block of the state Hessian (and, for the convex option,
     // projects it onto the positive semidefinite cone).
     auto symmetrise = [&](int d) {
@@ -183,8 +250,10 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       H.noalias() = h.eigen.eigenvectors() * h.eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
                     h.eigen.eigenvectors().transpose();
     };
+    // With `duration`, also the row and column of T from h.durationRow (∂²L/∂z∂T in the
+    // state and force columns) and h.durationCurvature (∂²L/∂T²).
     auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
-                      const std::vector<int>& forceColumns, LocalHessian& out) {
+                      const std::vector<int>& forceColumns, LocalHessian& out, bool duration) {
       const int k = weights.count, nf = static_cast<int>(forceColumns.size()), d = stateBlocks * n + nf;
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
@@ -210,6 +279,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       out.columns.resize(static_cast<std::size_t>(local));
       for (int c = 0; c < n * k; ++c) out.columns[static_cast<std::size_t>(c)] = parameters[c];
       for (int f = 0; f < nf; ++f) out.columns[static_cast<std::size_t>(n * k + f)] = forceColumns[static_cast<std::size_t>(f)];
+      if (!duration) return;
+      const auto byDuration = h.durationRow.head(d);
+      auto row = out.values.row(local).head(local);
+      row.setZero();
+      for (int j = 0; j < n; ++j)
+        for (int l = 0; l < k; ++l)
+          for (int block = 0; block < stateBlocks; ++block) row[j * k + l] += weight(block, l) * byDuration[block * n + j];
+      for (int f = 0; f < nf; ++f) row[n * k + f] = byDuration[stateBlocks * n + f];
+      out.values.col(local).head(local) = row.transpose();
+      out.values(local, local) = h.durationCurvature;
+      out.size = local + 1;
+      out.columns.push_back(parameterCount_);
     };
 
 #pragma omp for schedule(static)
@@ -220,7 +301,29 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
         sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
-        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)]);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false);
+        continue;
+      }
+      if (exact) {
+        sampleExactHessian(s, b, lambda, objectiveWeight, T, w, h, probe);
+        symmetrise(d);
+        if (freeDuration) {
+          // The chain rule through z_s(x, T) and the objective's weight c T (file comment).
+          const auto H = h.stateHessian.topLeftCorner(d, d);
+          auto g = h.base.head(d), cE = h.objectiveGradient.head(d), u = h.stateByDuration.head(d), dz = h.durationRow.head(d);
+          sampleLagrangianGradient(b, lambda, objectiveWeight, h, g);
+          sampleLagrangianGradient(b, h.zeroWeights, objectiveWeight / T, h, cE);
+          u.setZero();
+          u.segment(n, n) = -b.velocity / T;
+          u.segment(2 * n, n) = -2.0 / T * b.acceleration;
+          dz.noalias() = H * u;
+          h.durationCurvature = u.dot(dz) + 2.0 / (T * T) * g.segment(n, n).dot(b.velocity) +
+                                6.0 / (T * T) * g.segment(2 * n, n).dot(b.acceleration) + 2.0 * cE.dot(u);
+          dz.segment(n, n) -= g.segment(n, n) / T;
+          dz.segment(2 * n, n) -= 2.0 / T * g.segment(2 * n, n);
+          dz += cE;
+        }
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], freeDuration);
         continue;
       }
       auto base = h.base.head(d), gradient = h.gradient.head(d);
@@ -243,7 +346,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       // leave it at the unperturbed state.
       if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
-      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)]);
+      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false);
     }
 
 #pragma omp for schedule(static)
@@ -261,9 +364,27 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       base.head(n).noalias() = b.dyDq.transpose() * lambda;
       if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+      if (exact && velocity) h.stateByDuration.head(n) = w.v;  // q̇ at the instant, for ∂z/∂T
       for (int c = 0; c < d; ++c) {
         double& component = c < n ? w.q[c] : w.v[c - n];
-        const double saved = component, step = differenceStep(saved);
+        const double saved = component;
+        if (exact) {
+          // The task's gradient with its multipliers is trigonometric in an angle and linear in q̇.
+          const DerivativeStencil& stencil = c < n ? exactStencils_.taskAngle : exactStencils_.taskVelocity;
+          auto column = h.column.head(d);
+          column.setZero();
+          for (int m = 0; m < stencil.size(); ++m) {
+            component = saved + stencil.offsets[static_cast<std::size_t>(m)];
+            taskOutputs(i, true, w, taskProbe);
+            gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
+            if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+            column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
+          }
+          component = saved;
+          h.stateHessian.col(c).head(d) = column;
+          continue;
+        }
+        const double step = differenceStep(saved);
         component = saved + step;
         taskOutputs(i, true, w, taskProbe);
         component = saved;
@@ -272,7 +393,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       symmetrise(d);
-      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot);
+      const bool durationTerms = exact && freeDuration && velocity;
+      if (durationTerms) {
+        // z = (q, q̇ = B1 x / T): u = (0, −q̇/T), ĝ = (0, −g_q̇/T), z'' = (0, 2q̇/T²).
+        const auto H = h.stateHessian.topLeftCorner(d, d);
+        auto u = h.column.head(d), dz = h.durationRow.head(d);
+        u.head(n).setZero();
+        u.tail(n) = -h.stateByDuration.head(n) / T;
+        dz.noalias() = H * u;
+        h.durationCurvature = u.dot(dz) + 2.0 / (T * T) * base.tail(n).dot(h.stateByDuration.head(n));
+        dz.tail(n) -= base.tail(n) / T;
+      }
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms);
     }
   }
 
@@ -285,7 +417,21 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       for (int c = 0; c < l.size; ++c)
         hessian(l.columns[static_cast<std::size_t>(r)], l.columns[static_cast<std::size_t>(c)]) += l.values(r, c);
 
-  if (durationIsFree()) {
+  if (durationIsFree() && scenario_.hessian == HessianOption::Exact) {
+    // The samples and task instants brought theirs; the velocity-limit rows
+    // λ scale (x_second − x_first) / T add ∓λ scale / T² and 2 λ scale (x_second − x_first) / T³.
+    const int column = parameterCount_;
+    for (std::size_t r = 0; r < rows_.size(); ++r) {
+      if (rows_[r].kind != ConstraintKind::VelocityLimit) continue;
+      const VelocityRow& v = velocityRows_[static_cast<std::size_t>(rows_[r].block)];
+      const double lambda = multipliers[static_cast<Eigen::Index>(r)] * v.scale;
+      for (const auto& [variable, sign] : {std::pair{v.second, -1.0}, std::pair{v.first, 1.0}}) {
+        hessian(column, variable) += sign * lambda / (T * T);
+        hessian(variable, column) += sign * lambda / (T * T);
+      }
+      hessian(column, column) += 2.0 * lambda * (x[v.second] - x[v.first]) / (T * T * T);
+    }
+  } else if (durationIsFree()) {
     // The duration's row and column: a forward difference of the whole gradient.
     const int column = parameterCount_;
     Eigen::VectorXd base, plus, shifted = x;

@@ -113,6 +113,27 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm(),
                scenario.inner.problem),
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
+  // The scenario file checks this with its line; a command-line override (--contact-forces)
+  // or a hand-built scenario meets it here.
+  if (scenario_.hessian == HessianOption::Exact)
+    if (const std::string why = exactHessianRefusal(scenario_); !why.empty()) throw InputError("hessian: exact: " + why);
+  if (scenario_.hessian == HessianOption::Exact) {
+    // The degree of a weighted output gradient along one state component (docs/scenarios.md,
+    // "Hessian and convergence"; tests/core/test_dynamics_degree.cpp): Γ and the reference
+    // wrench are trigonometric of degree 2 in each joint angle (a moved body's world-frame
+    // inertia X* I X⁻¹ is second-degree in cos q, sin q; its velocity and acceleration
+    // first-degree), quadratic in q̇, affine in q̈ and in the force variables; the report
+    // model's friction-cone row squares the wrench. Task quantities (positions, orientations,
+    // the centre of mass, point velocities) are first-degree in cos q, sin q and linear in q̇;
+    // their angle stencil takes degree 2, which also holds for a product of two such factors.
+    const int power = support_.hasQuadraticRows() ? 2 : 1;
+    exactStencils_.angle = trigonometricStencil(2 * power);
+    exactStencils_.velocity = polynomialStencil(2 * power, 1.0);
+    exactStencils_.acceleration = polynomialStencil(power, 1.0);
+    exactStencils_.force = polynomialStencil(power, 1.0);
+    exactStencils_.taskAngle = trigonometricStencil(2);
+    exactStencils_.taskVelocity = polynomialStencil(1, 1.0);
+  }
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
   // Trapezoid weights as fractions of T: c_s / (N − 1), halved at the ends and, with a ball,

@@ -48,6 +48,7 @@
 #include "core/dynamics_derivatives.hpp"
 #include "core/dynamics_model.hpp"
 #include "outer_nlp/contact_force_parametrization.hpp"
+#include "outer_nlp/derivative_stencil.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
@@ -257,7 +258,18 @@ class MotionProblem final : public NlpProblem {
     Eigen::VectorXd probeX, weights, base, gradient;
     Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
+    // The exact option: outputs' weights held at the sample's point, a column being summed,
+    // zero multipliers (the objective's own gradient), and the duration's row in the state
+    // (dz/dT, ∂²L/∂z∂T) with its diagonal entry ∂²L/∂T².
+    Eigen::VectorXd fixedWeights, zeroWeights, column, objectiveGradient, stateByDuration, durationRow;
+    double durationCurvature = 0.0;
   };
+  /// The exact option's stencils (derivative_stencil.hpp): along a joint angle, a velocity, an
+  /// acceleration, a force variable of a sample, and a task instant's angle and velocity.
+  struct ExactStencils {
+    DerivativeStencil angle, velocity, acceleration, force, taskAngle, taskVelocity;
+  };
+  ExactStencils exactStencils_;
   /// One sample's (or task instant's) Bᵀ H B over its own columns: kept apart and summed in
   /// sample order afterwards, so that the Hessian does not depend on the thread count.
   struct LocalHessian {
@@ -275,6 +287,12 @@ class MotionProblem final : public NlpProblem {
   /// sample's state, outputs and derivatives in `b`.
   void sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h) const;
+  /// Σ_o weights_o ∇y_o in the state (q, q̇, q̈) and force columns of `b`, weights held fixed.
+  void outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  /// The exact option's H_s (HessianOption::Exact) into h.stateHessian (full, not yet
+  /// symmetrised): the gauss-newton terms plus the outputs' own curvature by the stencils.
+  void sampleExactHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                          double objectiveWeight, double duration, ThreadWorkspace& w, HessianWorkspace& h, SampleBlock& probe);
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;

@@ -339,7 +339,8 @@ constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited
                                          {HessianOption::FiniteDifferences, "finite-differences"},
                                          {HessianOption::SampleDifferences, "sample-differences"},
                                          {HessianOption::ConvexSampleDifferences, "convex-sample-differences"},
-                                         {HessianOption::GaussNewton, "gauss-newton"}};
+                                         {HessianOption::GaussNewton, "gauss-newton"},
+                                         {HessianOption::Exact, "exact"}};
 }  // namespace
 
 const char* toString(HessianOption hessian) {
@@ -352,8 +353,23 @@ HessianOption parseHessianOption(const std::string& name) {
   for (const HessianName& h : kHessianNames)
     if (name == h.name) return h.option;
   throw InputError(
-      "expected limited-memory, finite-differences, sample-differences, convex-sample-differences or gauss-newton, got '" +
-                   name + "'");
+      "expected limited-memory, finite-differences, sample-differences, convex-sample-differences, gauss-newton or "
+      "exact, got '" + name + "'");
+}
+
+std::string exactHessianRefusal(const Scenario& s) {
+  for (const TaskSpec& task : s.tasks)
+    if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease)
+      return "a throw's flight is not polynomial in the state (task '" + task.name + "'); use sample-differences";
+  if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
+    return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
+           "variables, or hessian: sample-differences";
+  for (const Joint& joint : s.robot.joints)
+    if (joint.type == JointType::Prismatic)
+      return "prismatic joint '" + joint.name + "': its stencil assumes revolute joints";
+  if (s.energyForm == EnergyForm::Epigraph && s.duration.free())
+    return "the epigraph form with a free duration (its slack × duration term lies outside the Hessian's variables)";
+  return {};
 }
 
 Scenario loadScenario(const std::filesystem::path& file) { return loadScenario(yaml::loadFile(file), file); }
@@ -573,6 +589,16 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
 
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   if (s.ball) checkThrowTask(file, throwNode, throwField, s);
+  if (s.hessian == HessianOption::Exact)
+    if (const std::string why = exactHessianRefusal(s); !why.empty())
+      throw InputError(where(file, root["hessian"], "hessian") + "exact: " + why);
+  for (std::size_t k = 0; k < s.continuation.size(); ++k)
+    if (s.continuation[k].hessian == HessianOption::Exact)
+      if (const std::string why = exactHessianRefusal(continuationStage(s, k)); !why.empty()) {
+        const std::string field = "continuation[" + std::to_string(k) + "]";
+        const YAML::Node stage = root["continuation"][k];
+        throw InputError(where(file, stage["hessian"] ? stage["hessian"] : root["hessian"], field + ".hessian") + "exact: " + why);
+      }
   return s;
 }
 

@@ -86,10 +86,17 @@ enum class HessianOption {
   /// Jacobian, the outputs' own curvature (∇²Γ, of the dynamics and the inner optimum)
   /// left out — a Gauss–Newton model. Task instants as sample-differences.
   GaussNewton,
+  /// The Lagrangian's Hessian itself: each H_s is the gauss-newton terms plus the outputs' own
+  /// curvature Σ_o w_o ∇²y_o, differentiated along each state component by a stencil that is
+  /// exact on how the dynamics depend on it (polynomial in q̇, q̈ and the force variables,
+  /// trigonometric in a revolute joint's angle: outer_nlp/derivative_stencil.hpp); task
+  /// instants the same; the duration's row and column by the chain rule. Exact up to
+  /// rounding. Not for what is not of that form (exactHessianRefusal).
+  Exact,
 };
 const char* toString(HessianOption hessian);
-/// "limited-memory", "finite-differences", "sample-differences", "convex-sample-differences"
-/// or "gauss-newton";
+/// "limited-memory", "finite-differences", "sample-differences", "convex-sample-differences",
+/// "gauss-newton" or "exact";
 /// throws InputError otherwise.
 HessianOption parseHessianOption(const std::string& name);
 
@@ -197,6 +204,13 @@ struct Scenario {
 /// Stage k of the scenario's continuation (k = continuation.size(): the scenario itself):
 /// a copy with that stage's friction sharpness, smoothing, samples and Hessian option.
 Scenario continuationStage(const Scenario& scenario, std::size_t k);
+/// Why `hessian: exact` does not apply to the scenario (empty when it does): its stencils need
+/// every sample output polynomial in q̇, q̈ and the force variables and trigonometric in the
+/// joint angles, which a throw's flight, an inner optimum (bilevel with environment contacts)
+/// and a prismatic joint are not; and the epigraph's slack × duration term lies outside the
+/// Hessian's variables.
+std::string exactHessianRefusal(const Scenario& scenario);
+
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws
 /// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints

@@ -11,6 +11,7 @@
 
 #include "common/finite_differences.hpp"
 #include "common/nlp_jacobian.hpp"
+#include "common/every_task_kind.hpp"
 #include "common/test_support.hpp"
 #include "outer_nlp/configuration_problem.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -85,22 +86,7 @@ TEST_CASE("outer problem: every task kind has exact derivatives", "[outer]") {
   Scenario scenario = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
   scenario.samples = 20;
   scenario.duration.lower = 1.0, scenario.duration.upper = 2.5;  // free T: the instants scale with it
-  const double inf = std::numeric_limits<double>::infinity();
-  auto task = [&](TaskKind kind, const char* body, double start, double end) {
-    TaskSpec t;
-    t.kind = kind, t.name = body, t.start = start, t.end = end, t.window = end > start;
-    if (kind != TaskKind::CenterOfMass) t.body = body, t.frame = scenario.robot.frameIndex(body);
-    t.lower = Eigen::Vector3d(-0.3, -inf, -1.0), t.upper = Eigen::Vector3d(0.3, 0.5, inf);
-    return t;
-  };
-  TaskSpec orientation = task(TaskKind::Orientation, "r_sole", 0.2, 0.9);
-  orientation.targetRotation = rotationFromRpy(0.1, -0.2, 0.3);
-  TaskSpec point = task(TaskKind::Position, "RARM_LINK5", 1.1, 1.1);
-  point.point = Vector3(0.02, -0.03, 0.1);
-  TaskSpec velocity = task(TaskKind::LinearVelocity, "HEAD_LINK1", 0.7, 0.7);
-  velocity.point = Vector3(0.1, 0.0, 0.05);
-  scenario.tasks = {orientation, point, velocity, task(TaskKind::AngularVelocity, "CHEST_LINK1", 0.5, 0.5),
-                    task(TaskKind::CenterOfMass, "", 0.0, 1.6)};
+  scenario.tasks = test::everyTaskKind(scenario);
   MotionProblem problem(scenario);
   Eigen::VectorXd x0 = problem.initialPoint(scenario.start, scenario.end);
   x0 = perturbed(x0, problem.parametrization().parameterCount(), 0.3, 5);
