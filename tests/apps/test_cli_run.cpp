@@ -478,8 +478,15 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"unknown Ipopt option", [](YAML::Node& r) { r["solver"]["max_iterations"] = 10; },
        {"solver.max_iterations: Ipopt rejects option 'max_iterations'"}},
       {"Ipopt option out of range", [](YAML::Node& r) { r["solver"]["tol"] = -1.0; }, {"solver.tol: Ipopt rejects option 'tol'"}},
-      {"unknown Hessian option", [](YAML::Node& r) { r["hessian"] = "exact"; },
-       {"hessian: expected limited-memory, finite-differences, sample-differences, convex-sample-differences or gauss-newton, got 'exact'"}},
+      {"unknown Hessian option", [](YAML::Node& r) { r["hessian"] = "newton"; },
+       {"hessian: expected limited-memory, finite-differences, sample-differences, convex-sample-differences, gauss-newton "
+        "or exact, got 'newton'"}},
+      {"exact Hessian where its stencils do not hold", [](YAML::Node& r) {
+         r["hessian"] = "exact";
+         r["objective"]["energy"] = "epigraph";
+         r["objective"].remove("smoothing");
+         r["duration"] = YAML::Load("{initial: 1.6, min: 1.2, max: 2.0}");
+       }, {"hessian: exact: the epigraph form with a free duration"}},
       {"continuation not a list", [](YAML::Node& r) { r["continuation"] = 3; }, {"continuation: expected a list"}},
       {"unknown continuation field", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{tol: 1.0}]"); },
        {"continuation[0].tol: unknown key"}},
