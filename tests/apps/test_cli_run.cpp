@@ -330,7 +330,7 @@ TEST_CASE("run: a smooth-maximum stage before the exact epigraph form, whose sla
 
 TEST_CASE("run: the offset-free kick — gauss-newton on the smooth maximum, then the epigraph with the exact Hessian — ends optimal",
           "[cli][run]") {
-  // docs/scenarios.md, "The criterion and the energy": the route that makes the criterion the
+  // docs/scenarios.md, "Hessian and convergence" and "Continuation": the route that makes the criterion the
   // energy. On 20 samples, measured: 459 + 56 iterations, criterion within 0.1 % of the energy.
   if (kUnderSanitizers) return;  // ~20 s in Release; the stages and the Hessian are tested on their own there
   const test::TempDir dir;
