@@ -79,9 +79,17 @@ bool waitFor(const std::function<bool()>& ready, double seconds) {
 }
 
 /// Cases 0 and 1 have final results, cases 2 and 3 have started.
+/// Whether case k's run has started Ipopt's iterations (its log shows the progress header):
+/// stopped from then on it has an iterate to write. A loaded machine can keep it in the
+/// configuration optimisation for seconds after its record appears.
+bool iterating(const std::filesystem::path& out, int k) {
+  const auto log = out / "cases" / (std::string(k < 10 ? "000" : "00") + std::to_string(k)) / "run.log";
+  return std::filesystem::exists(log) && fileText(log).find("   iter ") != std::string::npos;
+}
+
 bool firstTwoDoneLastTwoRunning(const std::filesystem::path& out) {
   return resultStatus(out, 0) == "maximum_iterations" && resultStatus(out, 1) == "maximum_iterations" &&
-         !caseRecord(out, 2).is_null() && !caseRecord(out, 3).is_null();
+         !caseRecord(out, 2).is_null() && !caseRecord(out, 3).is_null() && iterating(out, 2) && iterating(out, 3);
 }
 
 /// A restart ran cases 2 and 3 a second time and left 0 and 1 alone: their records and results
