@@ -61,6 +61,16 @@ void ContactAdmissibilityRows::evaluate(const Vector6& wrench, Eigen::Ref<Eigen:
   rowsByWrench.noalias() = rowsByContactWrench * toContact_;
 }
 
+Eigen::Matrix<double, 6, 6> ContactAdmissibilityRows::quadraticRowCurvature() const {
+  Eigen::Matrix<double, 6, 6> curvature = Eigen::Matrix<double, 6, 6>::Zero();
+  if (!smoothCone_) return curvature;
+  // (μ² f_z² − f_x² − f_y²) / (m g)² in W_C = A W: Aᵀ diag(−2, −2, 2μ², 0, 0, 0) A / (m g)².
+  Eigen::Matrix<double, 6, 1> diagonal = Eigen::Matrix<double, 6, 1>::Zero();
+  diagonal << -2.0, -2.0, 2.0 * surface_.friction * surface_.friction, 0.0, 0.0, 0.0;
+  curvature.noalias() = toContact_.transpose() * (scale_ * diagonal).asDiagonal() * toContact_;
+  return curvature;
+}
+
 Eigen::Vector2d ContactAdmissibilityRows::centerOfPressure(const Vector6& wrench) const {
   const Vector6 w = toContact_ * wrench;
   if (w[2] <= 0.0) return Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());

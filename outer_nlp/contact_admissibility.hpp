@@ -47,6 +47,10 @@ class ContactAdmissibilityRows {
   /// Whether a row is quadratic in W (the report model's friction cone); the others are linear.
   /// The exact Hessian's stencils take the degree from it (motion_hessian.cpp).
   bool hasQuadraticRows() const { return smoothCone_; }
+  /// The quadratic row's index (the report model's friction cone) and its constant second
+  /// derivative in W (6 × 6); -1 and zero for the linear models.
+  int quadraticRow() const { return smoothCone_ ? 1 : -1; }
+  Eigen::Matrix<double, 6, 6> quadraticRowCurvature() const;
   /// W: world axes, about the world origin (or C's own wrench with the identity pose).
   /// rows: rowCount() values; allocation-free.
   void evaluate(const Vector6& wrench, Eigen::Ref<Eigen::VectorXd> rows) const;

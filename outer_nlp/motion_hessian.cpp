@@ -78,12 +78,56 @@ void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& 
   if (forces > 0) gradient.tail(forces).noalias() = b.dyDz.leftCols(forces).transpose() * weights;
 }
 
+void MotionProblem::referenceWrenchJacobian(int s, const ThreadWorkspace& w,
+                                            Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> jacobian) const {
+  // W_ref = W0 − Σ wrenchToWorld_i F_i (sampleOutputs): its q columns with the environment
+  // wrenches' share, q̇ and q̈ those of W0, and −weight · wrenchToWorld_i on each force term.
+  const int n = jointCount_;
+  jacobian.leftCols(n) = w.referenceDq;
+  jacobian.middleCols(n, n) = w.derivatives.dwrenchDv;
+  jacobian.middleCols(2 * n, n) = w.derivatives.dwrenchDa;
+  int column = 3 * n;
+  for (int i = 0; i < outputs_.contacts; ++i)
+    for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
+      jacobian.middleCols<6>(column) = -t.weight * w.toWorld[static_cast<std::size_t>(i)];
+      column += 6;
+    }
+}
+
 void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                        double objectiveWeight, double T, ThreadWorkspace& w, HessianWorkspace& h,
                                        SampleBlock& probe) {
   const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
   // The energy's and the epigraph's curvature in the outputs (P in Γ, q̇, q̈; σ in P) ...
   sampleGaussNewtonHessian(b, multipliers, objectiveWeight, h);
+  auto H = h.stateHessian.topLeftCorner(d, d);
+  // ... the report model's friction-cone rows r(W), quadratic in the wrench: their
+  // curvature λ_cone J_Wᵀ ∇²r J_W exactly, and their weights moved onto the wrench — ω =
+  // Σ_r λ_r ∂r_r/∂W held at the point on W_ref, whose own curvature the stencils take (at
+  // the wrench's degrees, half the rows') — and on the environment wrenches, which are
+  // linear in the force variables (their rows' curvature is all there is) ...
+  const bool throughWrenches = support_.hasQuadraticRows();
+  samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+  if (throughWrenches) {
+    sampleOutputs(s, h.probeX, true, w, probe);  // the point's ∂rows/∂W_ref and ∂W_ref/∂z in w
+    h.wrenchWeights.setZero();
+    for (int r = 0; r < outputs_.rowsPerContact; ++r)
+      h.wrenchWeights += multipliers[outputs_.referenceRow(r)] * w.rowsByReference.row(r).transpose();
+    auto J = h.wrenchJacobian.leftCols(d), CJ = h.curvedWrenchJacobian.leftCols(d);
+    referenceWrenchJacobian(s, w, J);
+    CJ.noalias() = support_.quadraticRowCurvature() * J;
+    H.noalias() += multipliers[outputs_.referenceRow(support_.quadraticRow())] * J.transpose() * CJ;
+    int column = 3 * n;
+    for (int i = 0; i < outputs_.contacts; ++i) {
+      const ContactAdmissibilityRows& rows = contactRows_[static_cast<std::size_t>(i)];
+      const Matrix6 C = multipliers[outputs_.contactRow(i, rows.quadraticRow())] * rows.quadraticRowCurvature();
+      const auto& terms = forces_->terms(i, s);
+      for (std::size_t a = 0; a < terms.size(); ++a)
+        for (std::size_t c = 0; c < terms.size(); ++c)
+          H.block<6, 6>(column + 6 * static_cast<int>(a), column + 6 * static_cast<int>(c)) += terms[a].weight * terms[c].weight * C;
+      column += 6 * static_cast<int>(terms.size());
+    }
+  }
   // ... and the outputs' own: each output's weight at this point is its multiplier, plus on
   // Γ_j the power's slope times ∂P/∂Γ (P's own curvature is in the terms above).
   const bool smooth = scenario_.energyForm == EnergyForm::SmoothMaximum;
@@ -98,8 +142,8 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
     h.fixedWeights[outputs_.torque(j)] += slope * p.dTorque;
     h.fixedWeights[outputs_.power(j)] = 0.0;
   }
-  samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
-  auto H = h.stateHessian.topLeftCorner(d, d);
+  if (throughWrenches)  // their rows' weights are on the wrenches now
+    h.fixedWeights.segment(outputs_.referenceRow(0), outputs_.rowsPerContact * (1 + outputs_.contacts)).setZero();
   auto column = h.column.head(d), gradient = h.gradient.head(d);
   for (int c = 0; c < d; ++c) {
     double* component = c < n           ? &w.q[c]
@@ -116,6 +160,11 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
       *component = saved + stencil.offsets[static_cast<std::size_t>(m)];
       sampleOutputs(s, h.probeX, true, w, probe);
       outputGradient(probe, h.fixedWeights, gradient);
+      if (throughWrenches) {
+        auto J = h.wrenchJacobian.leftCols(d);
+        referenceWrenchJacobian(s, w, J);
+        gradient.noalias() += J.transpose() * h.wrenchWeights;
+      }
       column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
     }
     *component = saved;
@@ -212,6 +261,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
       h.fixedWeights.setZero(outputs), h.zeroWeights.setZero(outputs), h.column.setZero(largest);
       h.objectiveGradient.setZero(largest), h.stateByDuration.setZero(largest), h.durationRow.setZero(largest);
+      h.wrenchJacobian.setZero(6, largest), h.curvedWrenchJacobian.setZero(6, largest);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
     for (LocalHessian& l : localHessians_)  // + 1: the duration's row and column (exact option)

@@ -122,15 +122,16 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     // "Hessian and convergence"; tests/core/test_dynamics_degree.cpp): Γ and the reference
     // wrench are trigonometric of degree 2 in each joint angle (a moved body's world-frame
     // inertia X* I X⁻¹ is second-degree in cos q, sin q; its velocity and acceleration
-    // first-degree), quadratic in q̇, affine in q̈ and in the force variables; the report
-    // model's friction-cone row squares the wrench. Task quantities (positions, orientations,
-    // the centre of mass, point velocities) are first-degree in cos q, sin q and linear in q̇;
-    // their angle stencil takes degree 2, which also holds for a product of two such factors.
-    const int power = support_.hasQuadraticRows() ? 2 : 1;
-    exactStencils_.angle = trigonometricStencil(2 * power);
-    exactStencils_.velocity = polynomialStencil(2 * power, 1.0);
-    exactStencils_.acceleration = polynomialStencil(power, 1.0);
-    exactStencils_.force = polynomialStencil(power, 1.0);
+    // first-degree), quadratic in q̇, affine in q̈ and in the force variables. The report
+    // model's friction-cone row, quadratic in the wrench, enters through the wrench
+    // (motion_hessian.cpp), so these are the degrees for every contact model. Task
+    // quantities (positions, orientations, the centre of mass, point velocities) are
+    // first-degree in cos q, sin q and linear in q̇; their angle stencil takes degree 2, which
+    // also holds for a product of two such factors.
+    exactStencils_.angle = trigonometricStencil(2);
+    exactStencils_.velocity = polynomialStencil(2, 1.0);
+    exactStencils_.acceleration = polynomialStencil(1, 1.0);
+    exactStencils_.force = polynomialStencil(1, 1.0);
     exactStencils_.taskAngle = trigonometricStencil(2);
     exactStencils_.taskVelocity = polynomialStencil(1, 1.0);
   }

@@ -263,6 +263,10 @@ class MotionProblem final : public NlpProblem {
     // (dz/dT, ∂²L/∂z∂T) with its diagonal entry ∂²L/∂T².
     Eigen::VectorXd fixedWeights, zeroWeights, column, objectiveGradient, stateByDuration, durationRow;
     double durationCurvature = 0.0;
+    // The rows quadratic in the wrench enter through W_ref: its held weights ω, its Jacobian in
+    // the state and force columns at the sample's point, and C J_W for the rows' curvature.
+    Vector6 wrenchWeights = Vector6::Zero();
+    Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchJacobian, curvedWrenchJacobian;
   };
   /// The exact option's stencils (derivative_stencil.hpp): along a joint angle, a velocity, an
   /// acceleration, a force variable of a sample, and a task instant's angle and velocity.
@@ -289,6 +293,8 @@ class MotionProblem final : public NlpProblem {
                                 double objectiveWeight, HessianWorkspace& h) const;
   /// Σ_o weights_o ∇y_o in the state (q, q̇, q̈) and force columns of `b`, weights held fixed.
   void outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  /// ∂W_ref/∂(state, force columns) at the point sampleOutputs last evaluated in `w`, 6 × d.
+  void referenceWrenchJacobian(int s, const ThreadWorkspace& w, Eigen::Ref<Eigen::Matrix<double, 6, Eigen::Dynamic>> jacobian) const;
   /// The exact option's H_s (HessianOption::Exact) into h.stateHessian (full, not yet
   /// symmetrised): the gauss-newton terms plus the outputs' own curvature by the stencils.
   void sampleExactHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
