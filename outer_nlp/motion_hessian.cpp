@@ -86,12 +86,8 @@ void MotionProblem::referenceWrenchJacobian(int s, const ThreadWorkspace& w,
   jacobian.leftCols(n) = w.referenceDq;
   jacobian.middleCols(n, n) = w.derivatives.dwrenchDv;
   jacobian.middleCols(2 * n, n) = w.derivatives.dwrenchDa;
-  int column = 3 * n;
-  for (int i = 0; i < outputs_.contacts; ++i)
-    for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
-      jacobian.middleCols<6>(column) = -t.weight * w.toWorld[static_cast<std::size_t>(i)];
-      column += 6;
-    }
+  for (const SampleBlock::ForceTerm& t : blocks_[static_cast<std::size_t>(s)].forceTerms)
+    jacobian.middleCols<6>(3 * n + t.firstColumn) = -t.weight * w.toWorld[static_cast<std::size_t>(t.contact)];
 }
 
 void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
@@ -117,16 +113,15 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
     referenceWrenchJacobian(s, w, J);
     CJ.noalias() = support_.quadraticRowCurvature() * J;
     H.noalias() += multipliers[outputs_.referenceRow(support_.quadraticRow())] * J.transpose() * CJ;
-    int column = 3 * n;
-    for (int i = 0; i < outputs_.contacts; ++i) {
-      const ContactAdmissibilityRows& rows = contactRows_[static_cast<std::size_t>(i)];
-      const Matrix6 C = multipliers[outputs_.contactRow(i, rows.quadraticRow())] * rows.quadraticRowCurvature();
-      const auto& terms = forces_->terms(i, s);
-      for (std::size_t a = 0; a < terms.size(); ++a)
-        for (std::size_t c = 0; c < terms.size(); ++c)
-          H.block<6, 6>(column + 6 * static_cast<int>(a), column + 6 * static_cast<int>(c)) += terms[a].weight * terms[c].weight * C;
-      column += 6 * static_cast<int>(terms.size());
-    }
+    // An environment contact's wrench F_i = Σ_t weight_t z_t: its rows' curvature on each
+    // pair of its own terms.
+    for (const SampleBlock::ForceTerm& a : b.forceTerms)
+      for (const SampleBlock::ForceTerm& c : b.forceTerms) {
+        if (a.contact != c.contact) continue;
+        const ContactAdmissibilityRows& rows = contactRows_[static_cast<std::size_t>(a.contact)];
+        H.block<6, 6>(3 * n + a.firstColumn, 3 * n + c.firstColumn) +=
+            a.weight * c.weight * multipliers[outputs_.contactRow(a.contact, rows.quadraticRow())] * rows.quadraticRowCurvature();
+      }
   }
   // ... and the outputs' own: each output's weight at this point is its multiplier, plus on
   // Γ_j the power's slope times ∂P/∂Γ (P's own curvature is in the terms above).
@@ -414,7 +409,11 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       base.head(n).noalias() = b.dyDq.transpose() * lambda;
       if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
-      if (exact && velocity) h.stateByDuration.head(n) = w.v;  // q̇ at the instant, for ∂z/∂T
+      const bool durationTerms = exact && freeDuration && velocity;
+      if (durationTerms) {  // u = ∂z/∂T = (0, −q̇/T) at the instant, before the probes move q̇
+        h.stateByDuration.head(n).setZero();
+        h.stateByDuration.segment(n, n) = -w.v / T;
+      }
       for (int c = 0; c < d; ++c) {
         double& component = c < n ? w.q[c] : w.v[c - n];
         const double saved = component;
@@ -443,15 +442,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       symmetrise(d);
-      const bool durationTerms = exact && freeDuration && velocity;
       if (durationTerms) {
-        // z = (q, q̇ = B1 x / T): u = (0, −q̇/T), ĝ = (0, −g_q̇/T), z'' = (0, 2q̇/T²).
+        // z = (q, q̇ = B1 x / T): u = (0, −q̇/T), ĝ = (0, −g_q̇/T), z'' = (0, 2q̇/T²) = −2u/T.
         const auto H = h.stateHessian.topLeftCorner(d, d);
-        auto u = h.column.head(d), dz = h.durationRow.head(d);
-        u.head(n).setZero();
-        u.tail(n) = -h.stateByDuration.head(n) / T;
+        const auto u = h.stateByDuration.head(d);
+        auto dz = h.durationRow.head(d);
         dz.noalias() = H * u;
-        h.durationCurvature = u.dot(dz) + 2.0 / (T * T) * base.tail(n).dot(h.stateByDuration.head(n));
+        h.durationCurvature = u.dot(dz) - 2.0 / T * base.tail(n).dot(u.tail(n));
         dz.tail(n) -= base.tail(n) / T;
       }
       spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms);

@@ -201,8 +201,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
     // Local force columns: every term of every contact in contact here, six components each.
     for (int i = 0; forces_ && i < contacts; ++i)
-      for (const ContactForceParametrization::Term& t : forces_->terms(i, s))
+      for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
+        b.forceTerms.push_back({i, t.weight, static_cast<int>(b.forceColumns.size())});
         for (int c = 0; c < 6; ++c) b.forceColumns.push_back(t.variable + c);
+      }
     b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
     // Local parameters of every sample (the chain rule's column order), fixed for good.
     samples_.chainRule(s, 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
@@ -578,16 +580,15 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
       b.dyDa.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(d.dwrenchDa);
       // Force columns: ∂Γ/∂F_i = −J1_i, ∂rows_ref/∂F_i = −(∂rows/∂W_ref) wrenchToWorld_i,
       // ∂rows_i/∂F_i, each times the term's weight.
-      int column = 0;
-      for (int i = 0; i < contacts; ++i)
-        for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
-          const auto i_ = static_cast<std::size_t>(i);
-          b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
-          b.dyDz.block(outputs_.referenceRow(0), column, perContact, 6).noalias() =
-              -t.weight * rowsByReference.lazyProduct(w.toWorld[i_]);
-          b.dyDz.block(outputs_.contactRow(i, 0), column, perContact, 6) = t.weight * w.rowsByWrench[i_];
-          column += 6;
-        }
+      // (`b` may be a Hessian probe: the sample's own block holds the column layout.)
+      for (const SampleBlock::ForceTerm& t : blocks_[static_cast<std::size_t>(s)].forceTerms) {
+        const auto i_ = static_cast<std::size_t>(t.contact);
+        const int column = t.firstColumn;
+        b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
+        b.dyDz.block(outputs_.referenceRow(0), column, perContact, 6).noalias() =
+            -t.weight * rowsByReference.lazyProduct(w.toWorld[i_]);
+        b.dyDz.block(outputs_.contactRow(t.contact, 0), column, perContact, 6) = t.weight * w.rowsByWrench[i_];
+      }
     }
   }
 

@@ -228,6 +228,14 @@ class MotionProblem final : public NlpProblem {
     Eigen::MatrixXd dyDq, dyDv, dyDa;
     Eigen::MatrixXd dyDz;          ///< rows × local force columns
     std::vector<int> forceColumns; ///< global variable of each local force column
+    /// The force terms behind the local force columns, in their order: the contact, the
+    /// term's weight, its first local column (six each). Laid out once, with forceColumns.
+    struct ForceTerm {
+      int contact;
+      double weight;
+      int firstColumn;
+    };
+    std::vector<ForceTerm> forceTerms;
   };
   using ThreadWorkspace = MotionWorkspace;
   /// A row of the registry: its kind, what `detail` says (joint, contact row, task
