@@ -39,6 +39,7 @@ struct RunOptions {
   std::string contactForces;              ///< "", or a formulation: overrides the scenario
   int maxIterations = -1;
   std::string innerSolver;                ///< "", or an inner solver: overrides the scenario
+  std::string hessian;                    ///< "", or a Hessian option: every stage's (ScenarioOverrides)
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
   std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
 };
@@ -93,7 +94,7 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 
 int runMotion(const RunOptions& o) {
   Scenario scenario = loadScenario(o.scenario);
-  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver});
+  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian});
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   MotionProblem problem(scenario);
@@ -215,6 +216,10 @@ Runner addRun(CLI::App& command) {
   command.add_option("--inner-solver", o->innerSolver,
                      "active-set, slsqp or ipopt: override the scenario's inner.solver (bilevel, formulation.md §7)")
       ->check(CLI::IsMember(innerSolverNames()));
+  command.add_option("--hessian", o->hessian,
+                     "override the scenario's hessian and every continuation stage's; stages left differing in "
+                     "nothing else are dropped (docs/scenarios.md, \"Hessian and convergence\")")
+      ->check(CLI::IsMember(hessianOptionNames()));
   command.add_option("--start-from", o->startFrom,
                      "a result folder (or its result.json): start from its motion instead of the interpolated one; "
                      "configuration optimisation off; with another contact-force formulation its forces from the "

@@ -357,6 +357,15 @@ HessianOption parseHessianOption(const std::string& name) {
       "exact, got '" + name + "'");
 }
 
+const std::vector<std::string>& hessianOptionNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const HessianName& h : kHessianNames) all.emplace_back(h.name);
+    return all;
+  }();
+  return names;
+}
+
 std::string exactHessianRefusal(const Scenario& s) {
   for (const TaskSpec& task : s.tasks)
     if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease)

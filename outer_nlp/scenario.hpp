@@ -99,6 +99,8 @@ const char* toString(HessianOption hessian);
 /// "gauss-newton" or "exact";
 /// throws InputError otherwise.
 HessianOption parseHessianOption(const std::string& name);
+/// Every option's name, in the order above (the choices of `mcopt run --hessian`).
+const std::vector<std::string>& hessianOptionNames();
 
 /// A contact other than the reference body's: its surface is fixed in the world over the
 /// whole motion or over a window, at a given world pose or the one it has in the start

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <cmath>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "inner_qp/inner_solver.hpp"
@@ -40,6 +42,31 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
   return usable ? result.x : guess;
 }
 
+/// `--hessian`: every stage takes the option; a stage that then differs from the scenario in
+/// nothing but its iteration limit would solve the same problem again, so it goes.
+void overrideHessian(Scenario& scenario, const std::string& name) {
+  HessianOption hessian;
+  try {
+    hessian = parseHessianOption(name);
+  } catch (const InputError& e) {
+    throw InputError(std::string("--hessian: ") + e.what());
+  }
+  scenario.hessian = hessian;
+  std::vector<Scenario::ContinuationStage>& stages = scenario.continuation;
+  for (Scenario::ContinuationStage& stage : stages) stage.hessian = hessian;
+  stages.erase(std::remove_if(stages.begin(), stages.end(),
+                              [&](const Scenario::ContinuationStage& stage) {
+                                return stage.frictionSharpness == scenario.actuators.frictionSharpness &&
+                                       stage.smoothing == scenario.smoothing && stage.samples == scenario.samples &&
+                                       stage.energyForm == scenario.energyForm;
+                              }),
+               stages.end());
+  if (hessian != HessianOption::Exact) return;
+  for (std::size_t k = 0; k <= stages.size(); ++k)
+    if (const std::string why = exactHessianRefusal(continuationStage(scenario, k)); !why.empty())
+      throw InputError("--hessian: exact: " + why);
+}
+
 }  // namespace
 
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
@@ -55,6 +82,7 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
       throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected active-set, slsqp or ipopt)");
     scenario.inner.solverName = o.innerSolver;
   }
+  if (!o.hessian.empty()) overrideHessian(scenario, o.hessian);
   if (o.maxIterations >= 0) {
     SolverOption limit;
     limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;

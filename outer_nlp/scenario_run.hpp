@@ -24,9 +24,14 @@ struct ScenarioOverrides {
   std::string contactForces;              ///< "", or a formulation name (formulation.md §9)
   int maxIterations = -1;                 ///< Ipopt's max_iter for the motion; < 0: the scenario's
   std::string innerSolver;                ///< "", or an inner solver name (bilevel, formulation.md §7)
+  /// "", or a Hessian option name: the motion's and every continuation stage's. A stage left
+  /// differing from the scenario in nothing but its iteration limit (a Hessian hand-over, as
+  /// the bundled gauss-newton first stages are) is dropped.
+  std::string hessian;
 };
 
-/// Applies the overrides; throws InputError for a value that is not one of the choices.
+/// Applies the overrides; throws InputError for a value that is not one of the choices, and
+/// "--hessian: exact: …" where the exact Hessian's stencils do not hold (exactHessianRefusal).
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& overrides);
 
 /// Starts the scenario's motion optimisation from a given motion (a result's: `mcopt run

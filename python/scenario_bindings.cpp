@@ -124,11 +124,12 @@ py::dict iterationDict(const IterationRecord& h, const MotionProblem& problem) {
 
 py::dict run(const ScenarioHandle& s, const py::object& progress, const std::optional<std::filesystem::path>& out,
              const std::optional<int>& maxIterations, const std::optional<std::string>& contactForces,
-             const std::optional<bool>& configurationOptimisation) {
+             const std::optional<bool>& configurationOptimisation, const std::optional<std::string>& hessian) {
   Scenario scenario = s.scenario;
   ScenarioOverrides overrides;
   if (maxIterations) overrides.maxIterations = *maxIterations;
   if (contactForces) overrides.contactForces = *contactForces;
+  if (hessian) overrides.hessian = *hessian;
   if (configurationOptimisation) overrides.configurationOptimisation = *configurationOptimisation ? "on" : "off";
   applyOverrides(scenario, overrides);
   MotionProblem problem(scenario);
@@ -237,7 +238,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
           "Writes the scenario (side-file paths made absolute, so it loads from anywhere), atomically.")
       .def("run", &run, py::arg("progress") = py::none(), py::arg("out") = py::none(),
            py::arg("max_iterations") = py::none(), py::arg("contact_forces") = py::none(),
-           py::arg("configuration_optimisation") = py::none(),
+           py::arg("configuration_optimisation") = py::none(), py::arg("hessian") = py::none(),
            R"doc(Optimises the motion as `mcopt run` does and returns result.json's content as a dict
 (lists of numbers as numpy arrays: 'time' (N,), 'q', 'v', 'a', 'torques', 'power' (N, n), …)
 with 'x', the outer problem's variables. `out`: also write the run's files there.
@@ -248,7 +249,7 @@ is released while it runs (runs from several threads take turns: one Ipopt at a 
 linear solver MUMPS not being thread-safe); Ctrl-C (KeyboardInterrupt) stops it at the end of the current
 iteration and the result has status 'interrupted' with the last iterate. An exception
 raised by `progress` stops the run and is raised again. The overrides are those of
-`mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation.)doc")
+`mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation, --hessian.)doc")
       .def("__repr__", [](const ScenarioHandle& s) { return "<mcopt.Scenario " + s.file.string() + ">"; });
 }
 

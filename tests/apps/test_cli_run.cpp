@@ -551,6 +551,50 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
   CHECK_THAT(r.errors, Contains(malformed.string() + ":") && Contains("malformed YAML"));
 }
 
+TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages and refuses what exact cannot do", "[cli][run]") {
+  const test::TempDir dir;
+  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir,
+                                           [](YAML::Node& root) { root["samples"] = 12; }, "weight_shift.yaml");
+  // The bundled scenario: a gauss-newton stage, then sample-differences. With --hessian exact
+  // and wrenches as variables one stage is left, and it runs with the exact Hessian.
+  const auto out = dir.path() / "exact";
+  const auto r = test::runMcopt("run " + test::quoted(weightShift) + " --contact-forces variables --hessian exact --out " +
+                                test::quoted(out) + " --max-iterations 2");
+  INFO(r.all());
+  REQUIRE(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("motion optimisation (Ipopt, Hessian: exact;"));  // then the screened rows
+  const Json result = readJson(out / "result.json");
+  REQUIRE(result["continuation"].size() == 1);
+  CHECK(result["continuation"][0]["hessian"] == "exact");
+  CHECK(result["solver"]["hessian"] == "exact");
+  CHECK(result["history"].size() == 3);
+
+  // A stage that changes something else stays, with the override's Hessian.
+  const auto staged = scenarioVariant(kKick, dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+    root["continuation"] = YAML::Load("[{smoothing: 1.0, hessian: sample-differences, max_iterations: 1}]");
+  }, "kick_staged.yaml");
+  const auto twoStages = test::runMcopt("run " + test::quoted(staged) + " --hessian gauss-newton --out " +
+                                        test::quoted(dir.path() / "staged") + " --max-iterations 1 --configuration-optimisation off");
+  INFO(twoStages.all());
+  REQUIRE(twoStages.exitCode == 4);
+  const Json stages = readJson(dir.path() / "staged" / "result.json")["continuation"];
+  REQUIRE(stages.size() == 2);
+  CHECK(stages[0]["smoothing"] == 1.0);
+  CHECK(stages[0]["hessian"] == "gauss-newton");
+  CHECK(stages[1]["hessian"] == "gauss-newton");
+
+  // The bilevel formulation with environment contacts: the stencils do not hold; nothing runs.
+  const auto refused = test::runMcopt("run " + test::quoted(weightShift) + " --hessian exact --out " +
+                                      test::quoted(dir.path() / "never"));
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains("--hessian: exact: ") && Contains("bilevel"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "never"));
+  const auto unknown = test::runMcopt("run " + test::quoted(weightShift) + " --hessian newton");
+  CHECK(unknown.exitCode != 0);
+  CHECK_THAT(unknown.errors, Contains("--hessian"));
+}
+
 TEST_CASE("run: multi-contact results, torques reproduced from states and contact wrenches", "[cli][run][multi-contact]") {
   // Each formulation on the two-sole weight shift, a few iterations: result.json's torques
   // are Γ0 − J1 F of its own states and wrenches, as `mcopt dynamics --contacts` computes them.

@@ -91,6 +91,22 @@ def test_run_equals_the_cli(mcopt_exe, tmp_path):
         assert (tmp_path / "py" / name).read_text() == (tmp_path / "cli" / name).read_text(), name
 
 
+def test_the_hessian_override_equals_the_cli(mcopt_exe, tmp_path):
+    # The bundled kick's gauss-newton hand-over stage is dropped by the override on both sides.
+    s = mcopt.Scenario(KICK)
+    s["samples"] = 12
+    s.save(tmp_path / "kick.yaml")
+    run_cli(mcopt_exe, "run", tmp_path / "kick.yaml", "--hessian", "exact", "--max-iterations", 3,
+            "--configuration-optimisation", "off", "--out", tmp_path / "cli", check=False)
+    cli = json.loads((tmp_path / "cli" / "result.json").read_text())
+    result = s.run(max_iterations=3, configuration_optimisation=False, hessian="exact")
+    assert result["solver"]["hessian"] == "exact" == cli["solver"]["hessian"]
+    assert [stage["hessian"] for stage in result["continuation"]] == ["exact"]
+    assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
+    with pytest.raises(mcopt.InputError, match="--hessian"):
+        s.run(hessian="newton")
+
+
 def test_progress_returning_false_stops_with_the_last_iterate():
     s = small_kick()
     result = s.run(progress=lambda line: line["iteration"] < 3, configuration_optimisation=False)
