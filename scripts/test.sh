@@ -5,7 +5,7 @@
 # target (default 20; 0 skips). Set MCOPT_SKIP_SANITIZE=1 to run only the first.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
-jobs="$(nproc)"
+jobs="$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"
 "$root/scripts/install-deps.sh"
 
 cmake --preset release -S "$root"

@@ -126,8 +126,14 @@ TEST_CASE("throw: the one-foot throw ends optimal and its ball lands on the targ
 }
 
 TEST_CASE("throw: the hand-supported throw ends optimal and its ball lands on the target", "[cli][run][throw]") {
+  // On a grid of 0.1 s (25 samples, the release at 1.4 s one of them) instead of the bundled
+  // 0.04 s: the same contacts, window, ball and formulation, optimal after 472 Gauss–Newton
+  // iterations, ~30 s on one thread, where the bundled 61 samples take ~4 minutes (905
+  // iterations; docs/scenarios.md, "Throw: measured"), too long for the CI budget.
   const test::TempDir dir;
-  const Json result = runThrowAndCheckItsBall(test::sourceDir() / "scenarios/hrp2_throw_hand_support.yaml", dir);
+  const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_throw_hand_support.yaml", dir,
+                                              [](YAML::Node& root) { root["samples"] = 25; }, "hand_support.yaml");
+  const Json result = runThrowAndCheckItsBall(scenario, dir);
   // The left hand is a contact over its window only (the release, at 1.4 s, inside it).
   const Json& contacts = result.at("contacts");
   const auto hand = std::find_if(contacts.begin(), contacts.end(), [](const Json& c) { return c.at("name") == "l_hand"; });
