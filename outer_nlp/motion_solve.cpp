@@ -98,9 +98,7 @@ MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem,
     // the exact first derivatives, whatever Hessian shaped the steps. The later stages would
     // only restart from its optimum (measured: a restart with sample-differences wandered off
     // the lean reach's optimum; docs/scenarios.md).
-    const bool scenarioProblem = stageScenario.actuators.frictionSharpness == scenario.actuators.frictionSharpness &&
-                                 stageScenario.smoothing == scenario.smoothing && stageScenario.samples == scenario.samples &&
-                                 stageScenario.energyForm == scenario.energyForm;
+    const bool scenarioProblem = posesScenarioProblem(stageScenario, scenario);
     if (!last && scenarioProblem && usable && outcome.optimal()) {
       result.solver = outcome;
       break;

@@ -626,4 +626,9 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
   return stage;
 }
 
+bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
+  return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
+         stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
+}
+
 }  // namespace mcopt

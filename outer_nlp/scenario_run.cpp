@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/errors.hpp"
@@ -52,17 +53,15 @@ void overrideHessian(Scenario& scenario, const std::string& name) {
     throw InputError(std::string("--hessian: ") + e.what());
   }
   scenario.hessian = hessian;
-  std::vector<Scenario::ContinuationStage>& stages = scenario.continuation;
-  for (Scenario::ContinuationStage& stage : stages) stage.hessian = hessian;
-  stages.erase(std::remove_if(stages.begin(), stages.end(),
-                              [&](const Scenario::ContinuationStage& stage) {
-                                return stage.frictionSharpness == scenario.actuators.frictionSharpness &&
-                                       stage.smoothing == scenario.smoothing && stage.samples == scenario.samples &&
-                                       stage.energyForm == scenario.energyForm;
-                              }),
-               stages.end());
+  std::vector<Scenario::ContinuationStage> kept;
+  for (std::size_t k = 0; k < scenario.continuation.size(); ++k)
+    if (!posesScenarioProblem(continuationStage(scenario, k), scenario)) {
+      kept.push_back(scenario.continuation[k]);
+      kept.back().hessian = hessian;
+    }
+  scenario.continuation = std::move(kept);
   if (hessian != HessianOption::Exact) return;
-  for (std::size_t k = 0; k <= stages.size(); ++k)
+  for (std::size_t k = 0; k <= scenario.continuation.size(); ++k)
     if (const std::string why = exactHessianRefusal(continuationStage(scenario, k)); !why.empty())
       throw InputError("--hessian: exact: " + why);
 }
