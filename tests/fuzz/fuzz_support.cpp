@@ -8,15 +8,29 @@
 
 namespace mcopt::fuzz {
 
-const std::filesystem::path& workDir() {
-  static const std::filesystem::path dir = [] {
-    const std::filesystem::path d = std::filesystem::temp_directory_path() / ("mcopt-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(d / "scenarios");
+namespace {
+/// The folder, removed when the process exits normally (libFuzzer's end of -max_total_time,
+/// -runs, a replay), so that runs do not pile folders up in /tmp. After a finding libFuzzer
+/// leaves without static destructors, and the folder stays beside the finding.
+struct OwnFolder {
+  std::filesystem::path path;
+  OwnFolder() : path(std::filesystem::temp_directory_path() / ("mcopt-fuzz-" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path / "scenarios");
     std::error_code ignored;
-    std::filesystem::create_directory_symlink(std::filesystem::path(MCOPT_SOURCE_DIR) / "robots", d / "robots", ignored);
-    return d;
-  }();
-  return dir;
+    std::filesystem::create_directory_symlink(std::filesystem::path(MCOPT_SOURCE_DIR) / "robots", path / "robots", ignored);
+  }
+  ~OwnFolder() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);  // removes the robots link, not what it names
+  }
+  OwnFolder(const OwnFolder&) = delete;
+  OwnFolder& operator=(const OwnFolder&) = delete;
+};
+}  // namespace
+
+const std::filesystem::path& workDir() {
+  static const OwnFolder folder;
+  return folder.path;
 }
 
 void writeFile(const std::filesystem::path& path, const std::uint8_t* data, std::size_t size) {

@@ -19,7 +19,7 @@ namespace mcopt::fuzz {
 
 /// A folder of this process's own, with `robots` linked to the source tree's robots/, so that
 /// side files named as the bundled scenarios name them (../robots/hrp2/…) resolve from
-/// scenarios/ inside it.
+/// scenarios/ inside it. Removed when the process exits normally.
 const std::filesystem::path& workDir();
 
 /// The bytes as a file (created or truncated).
