@@ -6,8 +6,10 @@
 
 namespace mcopt {
 
-MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
+MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, const Eigen::VectorXd& x0,
                                const IpoptSettings& settings, const MotionSolveEvents& events) {
+  // Stages meant for another contact-force formulation are not run (and not counted).
+  const Scenario scenario = withStagesForItsFormulation(given);
   MotionSolveOutcome result;
   Eigen::VectorXd x = x0;
   const int stages = static_cast<int>(scenario.continuation.size()) + 1;

@@ -50,7 +50,8 @@ struct MotionSolveOutcome {
   std::string reason;               ///< why the solve ended before the scenario's own problem, if it did
 };
 
-/// `problem` is the scenario's own (full) motion problem; x0 its starting point.
+/// `problem` is the scenario's own (full) motion problem; x0 its starting point. Continuation
+/// stages for other contact-force formulations than the scenario's are left out.
 MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
                                const IpoptSettings& settings, const MotionSolveEvents& events);
 

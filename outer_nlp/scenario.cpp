@@ -1,7 +1,7 @@
 #include "outer_nlp/scenario_yaml.hpp"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include "core/errors.hpp"
@@ -559,8 +559,9 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       const std::string field = "continuation[" + std::to_string(k) + "]";
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
       yaml::rejectUnknownKeys(file, stage, field,
-                              {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy"});
-      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1, s.energyForm};
+                              {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy",
+                               "for_contact_forces"});
+      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1, s.energyForm, {}};
       if (stage["energy"]) {
         const std::string form = yaml::text(file, stage["energy"], field + ".energy");
         if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
@@ -572,6 +573,23 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
           c.hessian = parseHessianOption(yaml::text(file, stage["hessian"], field + ".hessian"));
         } catch (const InputError& e) {
           throw InputError(where(file, stage["hessian"], field + ".hessian") + e.what());
+        }
+      }
+      if (const YAML::Node only = stage["for_contact_forces"]) {
+        const std::string onlyField = field + ".for_contact_forces";
+        if (!only.IsSequence() || only.size() == 0)
+          throw InputError(where(file, only, onlyField) + "expected a non-empty list of formulations (bilevel, splines, variables)");
+        for (std::size_t i = 0; i < only.size(); ++i) {
+          const std::string item = onlyField + "[" + std::to_string(i) + "]";
+          ContactForces forces;
+          try {
+            forces = parseContactForces(yaml::text(file, only[i], item));
+          } catch (const InputError& e) {
+            throw InputError(where(file, only[i], item) + e.what());
+          }
+          if (std::find(c.forContactForces.begin(), c.forContactForces.end(), forces) != c.forContactForces.end())
+            throw InputError(where(file, only[i], item) + "'" + toString(forces) + "' is listed twice");
+          c.forContactForces.push_back(forces);
         }
       }
       if (stage["max_iterations"]) c.maxIterations = integerField(file, stage["max_iterations"], field + ".max_iterations", 1);
@@ -612,6 +630,17 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
 }
 
 }  // namespace
+
+Scenario withStagesForItsFormulation(const Scenario& scenario) {
+  Scenario kept = scenario;
+  kept.continuation.clear();
+  for (const Scenario::ContinuationStage& stage : scenario.continuation)
+    if (stage.forContactForces.empty() ||
+        std::find(stage.forContactForces.begin(), stage.forContactForces.end(), scenario.contactForces) !=
+            stage.forContactForces.end())
+      kept.continuation.push_back(stage);
+  return kept;
+}
 
 Scenario continuationStage(const Scenario& scenario, std::size_t k) {
   Scenario stage = scenario;

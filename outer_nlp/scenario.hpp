@@ -199,10 +199,19 @@ struct Scenario {
     /// slack variables the next stage sets at max(P, 0) of the motion reached (MotionProblem::
     /// pointFrom; docs/scenarios.md, "Continuation").
     EnergyForm energyForm = EnergyForm::SmoothMaximum;
+    /// The contact-force formulations the stage runs with (`for_contact_forces`); empty: every
+    /// one. A hand-over stage that helps one formulation may hinder another (measured on the
+    /// weight shift: Gauss–Newton first makes the bilevel run converge in seconds and keeps the
+    /// `variables` one from converging; docs/scenarios.md, "Multi-contact"), and
+    /// `mcopt run --contact-forces` chooses the formulation after the file is read.
+    std::vector<ContactForces> forContactForces;
   };
   std::vector<ContinuationStage> continuation;
 };
 
+/// The scenario with only the continuation stages that run with its contact-force
+/// formulation (ContinuationStage::forContactForces), in their order.
+Scenario withStagesForItsFormulation(const Scenario& scenario);
 /// Stage k of the scenario's continuation (k = continuation.size(): the scenario itself):
 /// a copy with that stage's friction sharpness, smoothing, samples and Hessian option.
 Scenario continuationStage(const Scenario& scenario, std::size_t k);

@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "common/json_file.hpp"
@@ -521,6 +522,15 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
        }, {"continuation[1].friction_sharpness: must be positive"}},
       {"unknown continuation Hessian", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{hessian: newton}]"); },
        {"continuation[0].hessian: expected limited-memory"}},
+      {"continuation stage for an unknown formulation", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel, splnes]}]");
+       }, {"continuation[0].for_contact_forces[1]: unknown contact-force formulation 'splnes'"}},
+      {"continuation stage formulation listed twice", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [splines, splines]}]");
+       }, {"continuation[0].for_contact_forces[1]: 'splines' is listed twice"}},
+      {"continuation stage formulations not a list", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: bilevel}]");
+       }, {"continuation[0].for_contact_forces: expected a non-empty list"}},
       {"continuation iteration limit not positive", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{max_iterations: 0}]");
        }, {"continuation[0].max_iterations: expected an integer ≥ 1"}},
@@ -593,6 +603,31 @@ TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages
   const auto unknown = test::runMcopt("run " + test::quoted(weightShift) + " --hessian newton");
   CHECK(unknown.exitCode != 0);
   CHECK_THAT(unknown.errors, Contains("--hessian"));
+}
+
+TEST_CASE("run: a continuation stage for some formulations runs only with them", "[cli][run][multi-contact]") {
+  // The bundled weight shift's Gauss–Newton hand-over stage is for the bilevel formulation
+  // alone (docs/scenarios.md, "Multi-contact"); here on 12 samples, one iteration a stage.
+  const test::TempDir dir;
+  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+    root["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel, splines]}]");
+  }, "weight_shift.yaml");
+  const std::map<std::string, std::vector<std::string>> stageHessians = {
+      {"bilevel", {"gauss-newton", "sample-differences"}},
+      {"splines", {"gauss-newton", "sample-differences"}},
+      {"variables", {"sample-differences"}}};
+  for (const auto& [formulation, hessians] : stageHessians) {
+    const auto out = dir.path() / formulation;
+    const auto r = test::runMcopt("run " + test::quoted(weightShift) + " --contact-forces " + formulation + " --out " +
+                                  test::quoted(out) + " --max-iterations 1");
+    INFO(formulation << ": " << r.all());
+    REQUIRE(r.exitCode == 4);
+    const Json stages = readJson(out / "result.json")["continuation"];
+    REQUIRE(stages.size() == hessians.size());
+    for (std::size_t k = 0; k < hessians.size(); ++k) CHECK(stages[k]["hessian"] == hessians[k]);
+    CHECK_THAT(r.output, Contains(hessians.size() == 1 ? "Hessian: sample-differences;" : "stage 1 of 2"));
+  }
 }
 
 TEST_CASE("run: multi-contact results, torques reproduced from states and contact wrenches", "[cli][run][multi-contact]") {
