@@ -577,6 +577,12 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       }
       if (const YAML::Node only = stage["for_contact_forces"]) {
         const std::string onlyField = field + ".for_contact_forces";
+        // With the reference contact alone the three formulations are one problem (§9), and
+        // whether such a stage ran would hang on a default that means nothing.
+        if (s.contacts.empty())
+          throw InputError(where(file, only, onlyField) +
+                           "the scenario has no contact besides the reference body's, where every formulation is the same "
+                           "problem");
         if (!only.IsSequence() || only.size() == 0)
           throw InputError(where(file, only, onlyField) + "expected a non-empty list of formulations (bilevel, splines, variables)");
         for (std::size_t i = 0; i < only.size(); ++i) {

@@ -523,14 +523,20 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"unknown continuation Hessian", [](YAML::Node& r) { r["continuation"] = YAML::Load("[{hessian: newton}]"); },
        {"continuation[0].hessian: expected limited-memory"}},
       {"continuation stage for an unknown formulation", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel, splnes]}]");
        }, {"continuation[0].for_contact_forces[1]: unknown contact-force formulation 'splnes'"}},
       {"continuation stage formulation listed twice", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [splines, splines]}]");
        }, {"continuation[0].for_contact_forces[1]: 'splines' is listed twice"}},
       {"continuation stage formulations not a list", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: bilevel}]");
        }, {"continuation[0].for_contact_forces: expected a non-empty list"}},
+      {"continuation stage formulations without a second contact", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel]}]");
+       }, {"continuation[0].for_contact_forces: the scenario has no contact besides the reference body's"}},
       {"continuation iteration limit not positive", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{max_iterations: 0}]");
        }, {"continuation[0].max_iterations: expected an integer ≥ 1"}},
