@@ -20,6 +20,7 @@ struct InnerOptions {
   int pyramidFacets = 8;
   double tikhonov = 1e-9;
   bool cold = false;
+  bool polish = false;
 };
 
 using json_io::Json;
@@ -38,6 +39,7 @@ int runInner(const InnerOptions& o) {
   settings.tikhonov = o.tikhonov;
   InnerSettings solverSettings;
   solverSettings.warmStart = !o.cold;
+  solverSettings.polish = o.polish;
   auto solver = makeInnerSolver(o.solver, solverSettings);
   SensitivitySettings sensitivitySettings;
   sensitivitySettings.backend = parseKktBackend(o.kktBackend);
@@ -95,6 +97,8 @@ Runner addInner(CLI::App& app) {
   app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8)");
   app.add_option("--tikhonov", o->tikhonov, "ε added to the objective's Hessian diagonal (default 1e-9)");
   app.add_flag("--cold", o->cold, "do not warm-start each problem from the previous one's result");
+  app.add_flag("--polish", o->polish,
+               "slsqp, ipopt: polish each answer on its own active set (linear contact models; docs/inner-problem.md)");
   app.add_flag("--sensitivity", o->sensitivity,
                "add dwrenches_dtau0 and dwrenches_dbalance (formulation.md §8) to each optimal result");
   app.add_option("--kkt-backend", o->kktBackend, "factorisation of the sensitivity's KKT system: dense (default), klu, umfpack");

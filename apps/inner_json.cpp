@@ -95,6 +95,7 @@ Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
   out["active_set"] = active;
   out["iterations"] = r.iterations;
   out["kkt_residual"] = r.kktResidual;
+  out["polished"] = r.polished;
   out["solve_time_us"] = r.solveTimeUs;
   out["balance_slack"] = json_io::toJson(r.balanceSlack);
   if (!r.message.empty()) out["message"] = r.message;

@@ -193,6 +193,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
       line["inner"] = {{"optimal", h.inner.optimal},
                        {"infeasible", h.inner.infeasible},
                        {"failed", h.inner.failed},
+                       {"polished", h.inner.polished},
                        {"mean_iterations", h.inner.meanIterations},
                        {"solve_seconds", h.inner.solveSeconds}};
     history.push_back(line);

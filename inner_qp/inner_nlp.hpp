@@ -135,7 +135,7 @@ using NlpRunner = std::function<RunOutcome(const ContactProblem& problem, Balanc
 /// find the balance slack of least norm (min ‖wrenchToWorld F − W‖² under the contact
 /// constraints), solve again with the balance shifted by it, and report Infeasible with that
 /// slack when it is not zero. Fills the whole result.
-void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, const NlpRunner& run,
+void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, const NlpRunner& solverRun,
                               InnerResult& result);
 
 /// Scale of the data for relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.

@@ -201,8 +201,95 @@ void takeMultipliers(const ContactProblem& p, const RunOutcome& outcome, InnerRe
   }
 }
 
-void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& settings, const NlpRunner& run,
+namespace {
+
+/// Solution polishing (Stellato et al., "OSQP", Math. Prog. Comp. 2020, §5.2, for our QP):
+/// the NLP solvers stop at a KKT residual near their tolerance, and a least balance slack
+/// below √(that residual) of the scale cannot be told from zero (solveWithElasticFallback).
+/// With linear rows only, the solution on an active set is one linear system:
+///   [H  Eᵀ] [F]   [−c]
+///   [E  0 ] [λ] = [ e],   E: the balance rows (unless dropped) and the active rows.
+/// Dependent active rows (an unloaded contact at the wrench cone's apex) leave it singular but
+/// consistent; the least-norm solution is one of its solutions.
+Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, const std::vector<int>& rows) {
+  const int n = 6 * p.contactCount;
+  const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
+  const auto m = static_cast<Eigen::Index>(balanceRows + rows.size());
+  Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + m, n + m);
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n + m);
+  kkt.topLeftCorner(n, n) = p.hessian;
+  rhs.head(n) = -p.gradient;
+  if (balanceRows > 0) {
+    kkt.block(n, 0, 6, n) = p.balance;
+    rhs.segment<6>(n) = p.balanceTarget;  // the band's centre in the elastic phase 2
+  }
+  for (std::size_t a = 0; a < rows.size(); ++a) {
+    const Eigen::Index at = n + balanceRows + static_cast<Eigen::Index>(a);
+    kkt.row(at).head(n) = p.inequality.row(rows[a]);
+    rhs[at] = p.inequalityBound[rows[a]];
+  }
+  kkt.topRightCorner(n, m) = kkt.bottomLeftCorner(m, n).transpose();
+  return kkt.completeOrthogonalDecomposition().solve(rhs).head(n);
+}
+
+/// The solver's answer polished: on the rows its multipliers hold (OSQP's choice: a row the
+/// solver finds at its bound with a multiplier below 1e-6 of the largest is not held; an
+/// interior-point solver leaves ~1e-8 on rows that are only nearly active), then, if that point is not
+/// kept, on every row at its bound. A polished point replaces the answer when it keeps every
+/// row and its KKT residual (multipliers estimated there, signs enforced) is smaller. Returns
+/// the residual of the answer kept.
+double polishOnActiveSet(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings, RunOutcome& outcome,
+                         Eigen::VectorXd& x) {
+  InnerResult before;
+  finishResult(p, x.data(), before);
+  takeMultipliers(p, outcome, before);
+  const double residualBefore = kktResidual(p, before);
+  if (!p.cones.empty() || !x.allFinite()) return residualBefore;
+  const double largest = before.inequalityMultipliers.size() > 0 ? before.inequalityMultipliers.maxCoeff() : 0.0;
+  std::vector<int> held;
+  for (const int row : before.activeSet)
+    if (before.inequalityMultipliers[row] > 1e-6 * (1.0 + largest)) held.push_back(row);
+  std::vector<std::vector<int>> candidates = {held};
+  if (held.size() != before.activeSet.size()) candidates.push_back(before.activeSet);
+  const double rowSlack = settings.tolerance * dataScale(p);
+  for (const std::vector<int>& rows : candidates) {
+    const Eigen::VectorXd polished = solveOnActiveRows(p, balance, rows);
+    if (!polished.allFinite()) continue;
+    if (p.inequality.rows() > 0 && (p.inequality * polished - p.inequalityBound).maxCoeff() > rowSlack) continue;
+    if (balance != BalanceMode::Dropped && (p.balance * polished - p.balanceTarget).cwiseAbs().maxCoeff() > rowSlack) continue;
+    InnerResult after;
+    finishResult(p, polished.data(), after);
+    estimateMultipliers(p, after);
+    const double residualAfter = kktResidual(p, after);
+    if (!(residualAfter < residualBefore)) continue;
+    x = polished;
+    outcome.hasMultipliers = false;  // estimated at the polished point
+    outcome.message += "; polished on its active set";
+    return residualAfter;
+  }
+  return residualBefore;
+}
+
+}  // namespace
+
+void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& settings, const NlpRunner& solverRun,
                               InnerResult& r) {
+  // Every run of the solver polished when asked (the first solve, the least-slack phase, the
+  // objective phase, the re-solve).
+  double lastResidual = -1.0;  // of the last polished run; -1: not polished
+  bool lastPolished = false;   // whether the last run's answer was replaced by its polished point
+  const NlpRunner run = [&](const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& s,
+                            Eigen::VectorXd& x) {
+    RunOutcome outcome = solverRun(problem, balance, band, s, x);
+    lastResidual = -1.0;
+    lastPolished = false;
+    if (s.polish && outcome.converged) {
+      const Eigen::VectorXd answer = x;
+      lastResidual = polishOnActiveSet(problem, balance, s, outcome, x);
+      lastPolished = x != answer;
+    }
+    return outcome;
+  };
   const auto start = std::chrono::steady_clock::now();
   const int n = 6 * p.contactCount;
   const double scale = dataScale(p);
@@ -232,6 +319,8 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     leastSlack.tikhonov = 0.0;
     Eigen::VectorXd y = x.allFinite() ? x : Eigen::VectorXd::Zero(n);
     RunOutcome phase1 = run(leastSlack, BalanceMode::Dropped, 0.0, settings, y);
+    const double polishedLeastSlackResidual = lastResidual;
+    const bool leastSlackPolished = lastPolished;
     r.leastSlackWrenches = y;
     // The least slack is an answer too: certified by its own KKT conditions, or not trusted.
     InnerResult leastSlackResult;
@@ -269,14 +358,18 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
       outcome.converged = phase1.converged;
       outcome.hasMultipliers = false;
       outcome.message += "; the objective step after the least-slack phase failed, its point is returned";
+      lastPolished = leastSlackPolished;
     }
     if (slack.cwiseAbs().maxCoeff() <= settings.tolerance * scale) slack.setZero();
     if (!phase1.converged) outcome.converged = false;
     // A certificate accurate to kktTolerance (relative) cannot tell a slack below
     // √kktTolerance of the data's scale from zero: the sample is treated as feasible and
     // solved again, from the elastic point, as the original problem; its own KKT check
-    // then decides (it is never called infeasible on such a slack).
-    if (slack.cwiseAbs().maxCoeff() <= std::sqrt(settings.kktTolerance) * scale) {
+    // then decides (it is never called infeasible on such a slack). A polished least-slack
+    // point is certified to its own, smaller residual, and tells slacks down to √ of that.
+    const double certificate =
+        polishedLeastSlackResidual >= 0.0 && phase1.converged ? polishedLeastSlackResidual : settings.kktTolerance;
+    if (slack.cwiseAbs().maxCoeff() <= std::sqrt(certificate) * scale) {
       diagnostics += "least slack negligible, solved again from the elastic point; ";
       const int before = outcome.iterations;
       outcome = run(p, BalanceMode::Equality, 0.0, settings, x);
@@ -290,6 +383,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
   r.balanceSlack = slack;
   takeMultipliers(*solved, outcome, r);
   r.iterations = outcome.iterations;
+  r.polished = lastPolished;  // of the run whose point is returned
   r.message = diagnostics + outcome.message;
   r.kktResidual = kktResidual(p, r);
   // A stop is a solution only where the KKT conditions hold (style.md §9: re-check, never

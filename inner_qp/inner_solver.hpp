@@ -26,6 +26,9 @@ struct InnerSettings {
   double kktTolerance = 1e-6;      ///< a stop counts as a solution only below this KKT residual
   int maxIterations = 500;
   bool warmStart = true;           ///< active-set method: start from the result passed in (its active set and wrenches)
+  /// SLSQP and Ipopt: polish each answer on its own active set (linear contact models; the
+  /// report model's cones are left as solved). docs/inner-problem.md, "Polishing".
+  bool polish = false;
 };
 
 struct InnerResult {
@@ -51,6 +54,7 @@ struct InnerResult {
   /// the least slack's size at this point (phase 2's wrenches are another minimiser of ‖s‖²,
   /// at which (∂B/∂q) F differs). Meaningful only when Infeasible.
   Eigen::VectorXd leastSlackWrenches;
+  bool polished = false;                ///< the answer was polished on its active set (InnerSettings::polish)
   std::string message;                  ///< the underlying solver's own words
 };
 

@@ -281,6 +281,7 @@ MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
     statistics.optimal += r.status == InnerStatus::Optimal;
     statistics.infeasible += r.status == InnerStatus::Infeasible;
     statistics.failed += r.status == InnerStatus::Failed;
+    statistics.polished += r.polished;
     statistics.meanIterations += r.iterations;
     statistics.solveSeconds += 1e-6 * r.solveTimeUs;
   }

@@ -136,6 +136,7 @@ class MotionProblem final : public NlpProblem {
   /// Bilevel: the inner problems of the last evaluation (all zero otherwise).
   struct InnerStatistics {
     int optimal = 0, infeasible = 0, failed = 0;
+    int polished = 0;             ///< answers polished on their active sets (inner.polish)
     double meanIterations = 0.0;  ///< inner solver iterations per sample
     double solveSeconds = 0.0;    ///< summed over the samples (threads overlap)
   };

@@ -281,7 +281,7 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
 }
 
 void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
-  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance"});
+  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish"});
   if (node["solver"]) {
     const std::string name = yaml::text(file, node["solver"], "inner.solver");
     if (!isInnerSolverName(name))
@@ -302,6 +302,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
   if (node["pyramid_facets"])
     s.inner.problem.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
   if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
+  if (node["polish"]) s.inner.solver.polish = flag(file, node["polish"], "inner.polish");
   if (node["kkt_backend"]) {
     try {
       s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));

@@ -199,6 +199,7 @@ An inner solver's result: status ('optimal', 'infeasible' with the least-norm ba
       .def_property_readonly("objective", [](const InnerResultHandle& r) { return r.result.objective; }, "Σ w Γ² + l Γ at the wrenches, without the Tikhonov term")
       .def_property_readonly("iterations", [](const InnerResultHandle& r) { return r.result.iterations; }, "the solver's iterations (its own count)")
       .def_property_readonly("kkt_residual", [](const InnerResultHandle& r) { return r.result.kktResidual; }, "largest of stationarity, feasibility and complementarity, relative to the data")
+      .def_property_readonly("polished", [](const InnerResultHandle& r) { return r.result.polished; }, "whether the answer was polished on its active set (InnerSolver(polish=True))")
       .def_property_readonly("balance_slack", [](const InnerResultHandle& r) { return vectorToNumpy(r.result.balanceSlack); }, "(6,): the least-norm balance slack when 'infeasible', zero otherwise")
       .def_property_readonly("active_set", [](const InnerResultHandle& r) -> py::object { const py::dict d = resultDict(r); return d["active_set"]; },
                              "names of the active rows (and '<contact>.cone' for active cones)")
@@ -226,18 +227,20 @@ the factorisation `backend` (dense, klu or umfpack): {'dwrenches_dtau0', 'dwrenc
 
   py::class_<InnerSolverHandle, std::shared_ptr<InnerSolverHandle>>(m, "InnerSolver", R"doc(
 An inner solver: 'active-set' (ours), 'slsqp' (NLopt) or 'ipopt'.)doc")
-      .def(py::init([](const std::string& name, double tolerance, double kktTolerance, int maxIterations, bool warmStart) {
+      .def(py::init([](const std::string& name, double tolerance, double kktTolerance, int maxIterations, bool warmStart,
+                       bool polish) {
              InnerSettings settings;
              settings.tolerance = tolerance, settings.kktTolerance = kktTolerance;
-             settings.maxIterations = maxIterations, settings.warmStart = warmStart;
+             settings.maxIterations = maxIterations, settings.warmStart = warmStart, settings.polish = polish;
              auto handle = std::make_shared<InnerSolverHandle>();
              handle->solver = makeInnerSolver(name, settings);
              handle->name = handle->solver->name();
              return handle;
            }),
            py::arg("name") = "active-set", py::arg("tolerance") = 1e-9, py::arg("kkt_tolerance") = 1e-6,
-           py::arg("max_iterations") = 500, py::arg("warm_start") = true,
-           "Settings as in inner_solver.hpp; `warm_start` False is `mcopt inner --cold`.")
+           py::arg("max_iterations") = 500, py::arg("warm_start") = true, py::arg("polish") = false,
+           "Settings as in inner_solver.hpp; `warm_start` False is `mcopt inner --cold`, `polish` True is "
+           "`mcopt inner --polish` (slsqp, ipopt: each answer polished on its own active set).")
       .def_property_readonly("name", [](const InnerSolverHandle& s) { return s.name; }, "'active-set', 'slsqp' or 'ipopt'")
       .def(
           "solve",

@@ -498,6 +498,8 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
        {"inner.contact_model: unknown contact model 'cone'"}},
       {"unknown inner solver", [](YAML::Node& r) { r["inner"]["solver"] = "qpoases"; },
        {"inner.solver: unknown inner solver 'qpoases'"}},
+      {"inner polishing not a flag", [](YAML::Node& r) { r["inner"]["polish"] = "sometimes"; },
+       {"inner.polish: expected true or false"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},
@@ -743,6 +745,28 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
     INFO(r.all());
     REQUIRE(r.exitCode == 4);
     CHECK(readJson(out / "result.json")["inner"]["solver"] == solver);
+  }
+  // inner.polish reaches the inner solver: SLSQP's answers polished on their active sets
+  // (docs/inner-problem.md, "Polishing"), counted per iteration; never the active-set method's.
+  for (const bool polish : {false, true}) {
+    const auto variant = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
+      root["samples"] = 8;
+      root["hessian"] = "limited-memory";
+      root["inner"]["polish"] = polish;
+    }, std::string("weight_shift_polish_") + (polish ? "on" : "off") + ".yaml");
+    for (const char* solver : {"slsqp", "active-set"}) {
+      const auto out = dir.path() / (std::string(solver) + (polish ? "_polished" : "_raw"));
+      const auto r = test::runMcopt("run " + test::quoted(variant) + " --inner-solver " + solver + " --out " +
+                                    test::quoted(out) + " --max-iterations 0 --configuration-optimisation off");
+      INFO(solver << ", polish " << polish << ": " << r.all());
+      REQUIRE(r.exitCode == 4);
+      const Json inner = readJson(out / "result.json")["history"][0]["inner"];
+      CHECK(inner["optimal"] == 8);
+      if (polish && std::string(solver) == "slsqp")
+        CHECK(inner["polished"].get<int>() > 0);
+      else
+        CHECK(inner["polished"] == 0);
+    }
   }
   const auto refused = test::runMcopt("run " + test::quoted(scenario) + " --inner-solver fsqp --out " + test::quoted(dir.path() / "no"));
   CHECK(refused.exitCode != 0);

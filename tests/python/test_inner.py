@@ -59,6 +59,29 @@ def test_solvers_equal_the_cli(mcopt_exe, hrp2, tmp_path, solver, model):
     assert "optimal" in statuses
 
 
+@pytest.mark.parametrize("solver", ["slsqp", "ipopt"])
+def test_polish_equals_the_cli_and_reaches_the_active_set_optimum(mcopt_exe, hrp2, tmp_path, solver):
+    """`polish=True` is `mcopt inner --polish`: each answer solved again on its own active set,
+    the active-set method's optimum to rounding (docs/inner-problem.md, "Polishing")."""
+    problems = motion_problems(hrp2, "wrench-cone")
+    write_json(tmp_path / "problems.json", {"problems": [p.to_dict() for p in problems]})
+    run_cli(mcopt_exe, "inner", "--problems", tmp_path / "problems.json", "--solver", solver, "--contact-model",
+            "wrench-cone", "--polish", "--out", tmp_path / "out.json")
+    cli = json.loads((tmp_path / "out.json").read_text())["results"]
+    polished, raw, reference = mcopt.InnerSolver(solver, polish=True), mcopt.InnerSolver(solver), mcopt.InnerSolver()
+    previous = previous_raw = None
+    for k, p in enumerate(problems):
+        again = mcopt.InnerProblem(**p.to_dict(), contact_model="wrench-cone")
+        result = polished.solve(again, previous)
+        previous = result
+        previous_raw = raw.solve(again, previous_raw)
+        assert result.status == cli[k]["status"] == "optimal", k
+        np.testing.assert_array_equal(result.wrenches.reshape(-1), np.concatenate(cli[k]["wrenches"]))
+        best = reference.solve(again)
+        assert abs(result.objective - best.objective) <= 1e-11 * (1 + abs(best.objective)), k
+        assert result.kkt_residual <= 1e-11 and result.kkt_residual <= previous_raw.kkt_residual, k
+
+
 @pytest.mark.parametrize("solver", ["active-set", "ipopt"])
 def test_an_infeasible_sample_equals_the_cli(mcopt_exe, hrp2, tmp_path, solver):
     """The right hand alone cannot carry the robot (it would have to pull): status
