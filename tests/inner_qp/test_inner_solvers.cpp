@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include <limits>
+#include <memory>
 #include <string>
 
 #include "common/random_inner_problem.hpp"
@@ -56,6 +57,22 @@ Vector6 exactLeastSlack(const std::string& what, const Vector6& demand, const st
 }
 
 double relativeGap(double value, double reference) { return std::abs(value - reference) / (1.0 + std::abs(reference)); }
+
+/// One third-party solver on a problem, as it answers and polished (InnerSettings::polish).
+struct RawAndPolished {
+  std::string name;
+  InnerResult raw, polished;
+};
+RawAndPolished solveRawAndPolished(std::unique_ptr<InnerSolver> (*make)(const InnerSettings&), const ContactProblem& p) {
+  InnerSettings polishing;
+  polishing.polish = true;
+  RawAndPolished out;
+  auto raw = make(InnerSettings{});
+  out.name = raw->name();
+  raw->solve(p, out.raw);
+  make(polishing)->solve(p, out.polished);
+  return out;
+}
 
 struct SolverTally {
   int optimal = 0;       ///< status Optimal (KKT-certified)
@@ -350,8 +367,6 @@ TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-
   // tolerances; a feasible problem is never called infeasible.
   std::mt19937 rng(131);
   auto activeSet = makeActiveSetSolver();
-  InnerSettings polishing;
-  polishing.polish = true;
   int compared = 0, polishedOptimal = 0, rawOptimal = 0;
 #ifdef MCOPT_UNDER_SANITIZERS
   constexpr int kTrials = 6;
@@ -365,12 +380,8 @@ TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-
     activeSet->solve(p, reference);
     if (reference.status != InnerStatus::Optimal) continue;
     for (auto make : {makeSlsqpSolver, makeIpoptSolver}) {
-      auto raw = make(InnerSettings{});
-      auto polished = make(polishing);
-      InnerResult a, b;
-      raw->solve(p, a);
-      polished->solve(p, b);
-      INFO("trial " << trial << ", " << raw->name() << ": raw " << toString(a.status) << " (" << a.message << "), KKT "
+      const auto [name, a, b] = solveRawAndPolished(make, p);
+      INFO("trial " << trial << ", " << name << ": raw " << toString(a.status) << " (" << a.message << "), KKT "
                     << a.kktResidual << "; polished " << toString(b.status) << " (" << b.message << "), KKT " << b.kktResidual);
       ++compared;
       CHECK(b.status != InnerStatus::Infeasible);
@@ -408,12 +419,8 @@ TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-
   // The least-slack phase's Tikhonov term (its unique minimiser) moves it by ~1e-9 of the demand.
   CHECK((least.balanceSlack - expected).cwiseAbs().maxCoeff() <= 1e-8 * 300.0);
   for (auto make : {makeSlsqpSolver, makeIpoptSolver}) {
-    auto raw = make(InnerSettings{});
-    auto polished = make(polishing);
-    InnerResult a, b;
-    raw->solve(tip, a);
-    polished->solve(tip, b);
-    INFO(raw->name() << ": raw " << toString(a.status) << " (" << a.message << "); polished " << toString(b.status) << " ("
+    const auto [name, a, b] = solveRawAndPolished(make, tip);
+    INFO(name << ": raw " << toString(a.status) << " (" << a.message << "); polished " << toString(b.status) << " ("
                      << b.message << "), slack " << b.balanceSlack.transpose() << " against " << expected.transpose());
     CHECK(a.status != InnerStatus::Optimal);
     CHECK(a.status != InnerStatus::Infeasible);
