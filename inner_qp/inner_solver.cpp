@@ -3,6 +3,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <chrono>
+#include <optional>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -237,14 +238,14 @@ Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, 
 /// interior-point solver leaves ~1e-8 on rows that are only nearly active), then, if that point is not
 /// kept, on every row at its bound. A polished point replaces the answer when it keeps every
 /// row and its KKT residual (multipliers estimated there, signs enforced) is smaller. Returns
-/// the residual of the answer kept.
-double polishOnActiveSet(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings, RunOutcome& outcome,
-                         Eigen::VectorXd& x) {
+/// the polished point's residual, or nothing when the answer stands as solved.
+std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings,
+                                        RunOutcome& outcome, Eigen::VectorXd& x) {
+  if (!p.cones.empty() || !x.allFinite()) return std::nullopt;
   InnerResult before;
   finishResult(p, x.data(), before);
   takeMultipliers(p, outcome, before);
   const double residualBefore = kktResidual(p, before);
-  if (!p.cones.empty() || !x.allFinite()) return residualBefore;
   const double largest = before.inequalityMultipliers.size() > 0 ? before.inequalityMultipliers.maxCoeff() : 0.0;
   std::vector<int> held;
   for (const int row : before.activeSet)
@@ -267,7 +268,7 @@ double polishOnActiveSet(const ContactProblem& p, BalanceMode balance, const Inn
     outcome.message += "; polished on its active set";
     return residualAfter;
   }
-  return residualBefore;
+  return std::nullopt;
 }
 
 }  // namespace
@@ -276,18 +277,12 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
                               InnerResult& r) {
   // Every run of the solver polished when asked (the first solve, the least-slack phase, the
   // objective phase, the re-solve).
-  double lastResidual = -1.0;  // of the last polished run; -1: not polished
-  bool lastPolished = false;   // whether the last run's answer was replaced by its polished point
+  std::optional<double> lastPolished;  // the last run's polished residual; empty: its answer stands as solved
   const NlpRunner run = [&](const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& s,
                             Eigen::VectorXd& x) {
     RunOutcome outcome = solverRun(problem, balance, band, s, x);
-    lastResidual = -1.0;
-    lastPolished = false;
-    if (s.polish && outcome.converged) {
-      const Eigen::VectorXd answer = x;
-      lastResidual = polishOnActiveSet(problem, balance, s, outcome, x);
-      lastPolished = x != answer;
-    }
+    lastPolished.reset();
+    if (s.polish && outcome.converged) lastPolished = polishOnActiveSet(problem, balance, s, outcome, x);
     return outcome;
   };
   const auto start = std::chrono::steady_clock::now();
@@ -319,8 +314,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     leastSlack.tikhonov = 0.0;
     Eigen::VectorXd y = x.allFinite() ? x : Eigen::VectorXd::Zero(n);
     RunOutcome phase1 = run(leastSlack, BalanceMode::Dropped, 0.0, settings, y);
-    const double polishedLeastSlackResidual = lastResidual;
-    const bool leastSlackPolished = lastPolished;
+    const std::optional<double> leastSlackPolished = lastPolished;
     r.leastSlackWrenches = y;
     // The least slack is an answer too: certified by its own KKT conditions, or not trusted.
     InnerResult leastSlackResult;
@@ -367,8 +361,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     // solved again, from the elastic point, as the original problem; its own KKT check
     // then decides (it is never called infeasible on such a slack). A polished least-slack
     // point is certified to its own, smaller residual, and tells slacks down to √ of that.
-    const double certificate =
-        polishedLeastSlackResidual >= 0.0 && phase1.converged ? polishedLeastSlackResidual : settings.kktTolerance;
+    const double certificate = leastSlackPolished && phase1.converged ? *leastSlackPolished : settings.kktTolerance;
     if (slack.cwiseAbs().maxCoeff() <= std::sqrt(certificate) * scale) {
       diagnostics += "least slack negligible, solved again from the elastic point; ";
       const int before = outcome.iterations;
@@ -383,7 +376,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
   r.balanceSlack = slack;
   takeMultipliers(*solved, outcome, r);
   r.iterations = outcome.iterations;
-  r.polished = lastPolished;  // of the run whose point is returned
+  r.polished = lastPolished.has_value();  // of the run whose point is returned
   r.message = diagnostics + outcome.message;
   r.kktResidual = kktResidual(p, r);
   // A stop is a solution only where the KKT conditions hold (style.md §9: re-check, never
