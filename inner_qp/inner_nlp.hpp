@@ -62,6 +62,12 @@ class InnerNlp {
           delta_ > 0.0 ? std::sqrt(shear2 + delta_ * delta_) - c.friction * F[c.index + 2]
                        : shear2 - c.friction * c.friction * F[c.index + 2] * F[c.index + 2];
     }
+    if (bandCount() > 0) {
+      // The elastic phase 2's band: −band ≤ balance F − target ≤ band, as two rows a component.
+      const Vector6 residual = p_.balance * F - p_.balanceTarget;
+      v.segment<6>(bandStart) = residual.array() - band_;
+      v.segment<6>(bandStart + 6) = -residual.array() - band_;
+    }
     if (jacobian) {
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> J(jacobian, inequalityCount(),
                                                                                             variableCount());
