@@ -102,9 +102,7 @@ TEST_CASE("determinism: mcopt inner with 1 and 2 threads and from run to run", "
   // A motion's inner problems (two soles, then a hand as well): the fuzz seed, reused.
   const auto problems = test::sourceDir() / "tests/fuzz/corpus/inner_problems/two_soles_then_hand.json";
   const test::TempDir dir;
-  // NLopt 2.7.1's SLSQP reads memory it never initialised (valgrind: inside nlopt_slsqp), so
-  // its iterations differ from run to run: docs/inner-problem.md, "Determinism".
-  for (const char* solver : {"active-set", "ipopt"}) {
+  for (const char* solver : {"active-set", "slsqp", "ipopt"}) {
     std::vector<Json> outputs;
     for (const char* threads : {"1", "2", "2"}) {
       const auto out = dir.path() / (std::string(solver) + "-" + std::to_string(outputs.size()) + ".json");
@@ -121,32 +119,4 @@ TEST_CASE("determinism: mcopt inner with 1 and 2 threads and from run to run", "
     CHECK(outputs[0] == outputs[1]);
     CHECK(outputs[1] == outputs[2]);
   }
-  // SLSQP: the documented tolerance instead of bits — the same statuses, and wrenches and
-  // objectives equal to 1e-6 of their scale from run to run and thread count to thread count.
-  std::vector<Json> slsqp;
-  for (const char* threads : {"1", "2", "2"}) {
-    const auto out = dir.path() / ("slsqp-" + std::to_string(slsqp.size()) + ".json");
-    const auto r = test::runMcopt("inner --problems " + test::quoted(problems) + " --solver slsqp --out " + test::quoted(out),
-                                  std::string("OMP_NUM_THREADS=") + threads);
-    INFO(r.all());
-    REQUIRE(r.exitCode == 0);
-    slsqp.push_back(Json::parse(readText(out)));
-  }
-  for (std::size_t run = 1; run < slsqp.size(); ++run)
-    for (std::size_t k = 0; k < slsqp[0]["results"].size(); ++k) {
-      const Json& a = slsqp[0]["results"][k];
-      const Json& b = slsqp[run]["results"][k];
-      INFO("run " << run << ", problem " << k);
-      CHECK(a["status"] == b["status"]);
-      const double objective = a["objective"].get<double>();
-      CHECK(std::abs(objective - b["objective"].get<double>()) <= 1e-6 * (1.0 + std::abs(objective)));
-      double scale = 1.0, difference = 0.0;
-      for (std::size_t c = 0; c < a["wrenches"].size(); ++c)
-        for (std::size_t i = 0; i < 6; ++i) {
-          const double x = a["wrenches"][c][i].get<double>(), y = b["wrenches"][c][i].get<double>();
-          scale = std::max(scale, std::abs(x));
-          difference = std::max(difference, std::abs(x - y));
-        }
-      CHECK(difference <= 1e-6 * scale);
-    }
 }
