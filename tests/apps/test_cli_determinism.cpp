@@ -85,9 +85,9 @@ TEST_CASE("determinism: the bilevel weight shift, inner solves warm-started, wit
   sameWithAnyThreads(dir, scenario, "--contact-forces bilevel --inner-solver active-set --max-iterations 3 --checkpoint-seconds -1");
 }
 
-// NLopt 2.7.1's SLSQP reads parts of its workspace before writing them; without
-// inner_qp/slsqp_solver.cpp's zero-filled allocations this run's 12th iteration differed
-// in the seventh digit with the output folder's name (docs/inner-problem.md, "Determinism").
+// While InnerNlp left the elastic phase's band rows unwritten, SLSQP read whatever its
+// constraint buffer held, and this run's 12th iteration differed in the seventh digit with
+// the output folder's name (docs/inner-problem.md, "Determinism").
 TEST_CASE("determinism: the bilevel weight shift with SLSQP inside, whatever the heap held before", "[cli][determinism]") {
   const test::TempDir dir;
   const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
