@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -212,6 +213,7 @@ namespace {
 ///   [E  0 ] [λ] = [ e],   E: the balance rows (unless dropped) and the active rows.
 /// Dependent active rows (an unloaded contact at the wrench cone's apex) leave it singular but
 /// consistent; the least-norm solution is one of its solutions.
+/// Returns F and then the multipliers (the balance rows', then the active rows' in their order).
 Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, const std::vector<int>& rows) {
   const int n = 6 * p.contactCount;
   const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
@@ -230,17 +232,91 @@ Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, 
     rhs[at] = p.inequalityBound[rows[a]];
   }
   kkt.topRightCorner(n, m) = kkt.bottomLeftCorner(m, n).transpose();
-  return kkt.completeOrthogonalDecomposition().solve(rhs).head(n);
+  return kkt.completeOrthogonalDecomposition().solve(rhs);
+}
+
+/// The elastic phase 2's problem with its band −band ≤ B F − target ≤ band as twelve linear
+/// rows after the contact rows (BalanceMode::Band), for a solve with the balance dropped.
+ContactProblem withBandRows(const ContactProblem& p, double band) {
+  ContactProblem banded = p;
+  const Eigen::Index rows = p.inequality.rows();
+  const int n = 6 * p.contactCount;
+  banded.inequality.resize(rows + 12, n);
+  banded.inequalityBound.resize(rows + 12);
+  banded.inequality.topRows(rows) = p.inequality;
+  banded.inequalityBound.head(rows) = p.inequalityBound;
+  banded.inequality.middleRows(rows, 6) = p.balance;
+  banded.inequality.bottomRows(6) = -p.balance;
+  banded.inequalityBound.segment<6>(rows) = p.balanceTarget.array() + band;
+  banded.inequalityBound.tail<6>() = -p.balanceTarget.array() + band;
+  banded.balance.setZero();
+  banded.balanceTarget.setZero();
+  return banded;
+}
+
+/// Crossover, as interior-point LP solvers end on a basis: from the rows the answer's
+/// multipliers hold, the row the solution on them violates most is added, or else the row
+/// with the most negative multiplier dropped, one row a round, until the solution keeps every
+/// row with multipliers ≥ 0: the QP's own KKT point, with its exact multipliers (in the form
+/// RunOutcome carries them). Empty when a set of rows comes back (an infeasible problem cycles)
+/// or the rounds run out.
+/// Needed where an answer is accurate in its objective but not in its point: the least-slack
+/// phase's Hessian 2BᵀB + εI has rank 6 but for ε, so an NLP solver's least-slack point lies
+/// anywhere along the near-flat directions, the rows tight there are not the minimiser's, and
+/// the solution on them leaves the admissible set; its least slack is then right to the square
+/// root of its objective's accuracy only, and phase 2 (the objective at that balance) moved by
+/// 50 to 109 N of wrench for 1e-5 N of slack on the weight shift (docs/inner-problem.md,
+/// "Polishing").
+std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance, double rowSlack, std::vector<int> rows,
+                                    Eigen::VectorXd& x) {
+  const int n = 6 * p.contactCount;
+  const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
+  const auto maxRounds = 4 * p.inequality.rows() + 10;
+  std::set<std::vector<int>> visited;
+  for (Eigen::Index round = 0; round < maxRounds; ++round) {
+    std::vector<int> sorted = rows;
+    std::sort(sorted.begin(), sorted.end());
+    if (!visited.insert(std::move(sorted)).second) return std::nullopt;
+    const Eigen::VectorXd solution = solveOnActiveRows(p, balance, rows);
+    if (!solution.allFinite()) return std::nullopt;
+    const auto F = solution.head(n);
+    Eigen::VectorXd violation = p.inequality * F - p.inequalityBound;
+    for (const int row : rows) violation[row] = -1.0;  // held: at their bound
+    Eigen::Index worst = -1;
+    if (violation.size() > 0 && violation.maxCoeff(&worst) > rowSlack) {
+      rows.push_back(static_cast<int>(worst));
+      continue;
+    }
+    const auto multipliers = solution.tail(static_cast<Eigen::Index>(rows.size()));
+    Eigen::Index mostNegative = -1;
+    const double threshold = -1e-12 * (1.0 + (multipliers.size() > 0 ? multipliers.cwiseAbs().maxCoeff() : 0.0));
+    if (multipliers.size() > 0 && multipliers.minCoeff(&mostNegative) < threshold) {
+      rows.erase(rows.begin() + mostNegative);
+      continue;
+    }
+    if (balanceRows > 0 && (p.balance * F - p.balanceTarget).cwiseAbs().maxCoeff() > rowSlack) return std::nullopt;
+    RunOutcome outcome;
+    outcome.converged = true;
+    outcome.hasMultipliers = true;
+    if (balanceRows > 0) outcome.equalityMultipliers = solution.segment<6>(n);
+    outcome.inequalityMultipliers.setZero(p.inequality.rows());
+    for (std::size_t a = 0; a < rows.size(); ++a)
+      outcome.inequalityMultipliers[rows[a]] = std::max(multipliers[static_cast<Eigen::Index>(a)], 0.0);
+    x = F;
+    return outcome;
+  }
+  return std::nullopt;
 }
 
 /// The solver's answer polished: on the rows its multipliers hold (OSQP's choice: a row the
 /// solver finds at its bound with a multiplier below 1e-6 of the largest is not held; an
-/// interior-point solver leaves ~1e-8 on rows that are only nearly active), then, if that point is not
-/// kept, on every row at its bound. A polished point replaces the answer when it keeps every
-/// row and its KKT residual (multipliers estimated there, signs enforced) is smaller. Returns
-/// the polished point's residual, or nothing when the answer stands as solved.
-std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings,
-                                        RunOutcome& outcome, Eigen::VectorXd& x) {
+/// interior-point solver leaves ~1e-8 on rows that are only nearly active), on every row at its
+/// bound (multipliers estimated there, signs enforced), and by crossover from the held rows
+/// (its own multipliers). The candidate that keeps every row with the smallest KKT residual
+/// replaces the answer when that residual is smaller than the answer's. Returns the polished
+/// point's residual, or nothing when the answer stands as solved.
+std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, double band,
+                                        const InnerSettings& settings, RunOutcome& outcome, Eigen::VectorXd& x) {
   if (!p.cones.empty() || !x.allFinite()) return std::nullopt;
   InnerResult before;
   finishResult(p, x.data(), before);
@@ -250,25 +326,49 @@ std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode bal
   std::vector<int> held;
   for (const int row : before.activeSet)
     if (before.inequalityMultipliers[row] > 1e-6 * (1.0 + largest)) held.push_back(row);
-  std::vector<std::vector<int>> candidates = {held};
-  if (held.size() != before.activeSet.size()) candidates.push_back(before.activeSet);
   const double rowSlack = settings.tolerance * dataScale(p);
-  for (const std::vector<int>& rows : candidates) {
-    const Eigen::VectorXd polished = solveOnActiveRows(p, balance, rows);
-    if (!polished.allFinite()) continue;
-    if (p.inequality.rows() > 0 && (p.inequality * polished - p.inequalityBound).maxCoeff() > rowSlack) continue;
-    if (balance != BalanceMode::Dropped && (p.balance * polished - p.balanceTarget).cwiseAbs().maxCoeff() > rowSlack) continue;
+  const int n = 6 * p.contactCount;
+  Eigen::VectorXd best;
+  double bestResidual = residualBefore;
+  std::optional<RunOutcome> bestCrossed;  // the crossover's outcome, when it is the best
+  const auto consider = [&](const Eigen::VectorXd& polished, const std::optional<RunOutcome>& crossed) {
+    if (!polished.allFinite()) return;
+    if (p.inequality.rows() > 0 && (p.inequality * polished - p.inequalityBound).maxCoeff() > rowSlack) return;
+    if (balance != BalanceMode::Dropped && (p.balance * polished - p.balanceTarget).cwiseAbs().maxCoeff() > band + rowSlack)
+      return;
     InnerResult after;
     finishResult(p, polished.data(), after);
-    estimateMultipliers(p, after);
+    if (crossed)
+      takeMultipliers(p, *crossed, after);
+    else
+      estimateMultipliers(p, after);
     const double residualAfter = kktResidual(p, after);
-    if (!(residualAfter < residualBefore)) continue;
-    x = polished;
+    if (!(residualAfter < bestResidual)) return;
+    best = polished;
+    bestResidual = residualAfter;
+    bestCrossed = crossed;
+  };
+  consider(solveOnActiveRows(p, balance, held).head(n), std::nullopt);
+  if (held.size() != before.activeSet.size()) consider(solveOnActiveRows(p, balance, before.activeSet).head(n), std::nullopt);
+  // In the band the crossover holds the band's twelve rows as the solver did, as rows: the
+  // optimum may lean on the band's edge, away from its centre (the simple candidates' balance).
+  Eigen::VectorXd crossed;
+  if (const std::optional<RunOutcome> crossing = balance == BalanceMode::Band
+                                                     ? crossover(withBandRows(p, band), BalanceMode::Dropped, rowSlack, held, crossed)
+                                                     : crossover(p, balance, rowSlack, held, crossed))
+    consider(crossed, crossing);
+  if (best.size() == 0) return std::nullopt;
+  x = best;
+  if (bestCrossed) {
+    outcome.hasMultipliers = true;
+    outcome.equalityMultipliers = bestCrossed->equalityMultipliers;
+    outcome.inequalityMultipliers = bestCrossed->inequalityMultipliers;
+    outcome.message += "; polished by crossover from its active set";
+  } else {
     outcome.hasMultipliers = false;  // estimated at the polished point
     outcome.message += "; polished on its active set";
-    return residualAfter;
   }
-  return std::nullopt;
+  return bestResidual;
 }
 
 }  // namespace
@@ -282,7 +382,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
                             Eigen::VectorXd& x) {
     RunOutcome outcome = solverRun(problem, balance, band, s, x);
     lastPolished.reset();
-    if (s.polish && outcome.converged) lastPolished = polishOnActiveSet(problem, balance, s, outcome, x);
+    if (s.polish && outcome.converged) lastPolished = polishOnActiveSet(problem, balance, band, s, outcome, x);
     return outcome;
   };
   const auto start = std::chrono::steady_clock::now();
