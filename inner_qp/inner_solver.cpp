@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <optional>
-#include <set>
 #include <sstream>
 
 #include "core/errors.hpp"
@@ -254,12 +253,11 @@ ContactProblem withBandRows(const ContactProblem& p, double band) {
   return banded;
 }
 
-/// Crossover, as interior-point LP solvers end on a basis: from the rows the answer's
-/// multipliers hold, the row the solution on them violates most is added, or else the row
-/// with the most negative multiplier dropped, one row a round, until the solution keeps every
-/// row with multipliers ≥ 0: the QP's own KKT point, with its exact multipliers (in the form
-/// RunOutcome carries them). Empty when a set of rows comes back (an infeasible problem cycles)
-/// or the rounds run out.
+/// Crossover, as interior-point LP solvers end on a basis: the QP solved exactly by our dual
+/// active-set method (the active-set solver's core), started from the rows the answer's
+/// multipliers hold; its point and exact multipliers, in the form RunOutcome carries them, or
+/// nothing when it does not end optimal. A primal add-one-drop-one loop from the same rows
+/// cycled on the weight shift's degenerate band vertices, as such loops do.
 /// Needed where an answer is accurate in its objective but not in its point: the least-slack
 /// phase's Hessian 2BᵀB + εI has rank 6 but for ε, so an NLP solver's least-slack point lies
 /// anywhere along the near-flat directions, the rows tight there are not the minimiser's, and
@@ -267,61 +265,55 @@ ContactProblem withBandRows(const ContactProblem& p, double band) {
 /// root of its objective's accuracy only, and phase 2 (the objective at that balance) moved by
 /// 50 to 109 N of wrench for 1e-5 N of slack on the weight shift (docs/inner-problem.md,
 /// "Polishing").
-std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance, double rowSlack, std::vector<int> rows,
-                                    Eigen::VectorXd& x) {
+std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings,
+                                    const std::vector<int>& rows, Eigen::VectorXd& x) {
   const int n = 6 * p.contactCount;
   const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
-  const auto maxRounds = 4 * p.inequality.rows() + 10;
-  std::set<std::vector<int>> visited;
-  for (Eigen::Index round = 0; round < maxRounds; ++round) {
-    std::vector<int> sorted = rows;
-    std::sort(sorted.begin(), sorted.end());
-    if (!visited.insert(std::move(sorted)).second) return std::nullopt;
-    const Eigen::VectorXd solution = solveOnActiveRows(p, balance, rows);
-    if (!solution.allFinite()) return std::nullopt;
-    const auto F = solution.head(n);
-    Eigen::VectorXd violation = p.inequality * F - p.inequalityBound;
-    for (const int row : rows) violation[row] = -1.0;  // held: at their bound
-    Eigen::Index worst = -1;
-    if (violation.size() > 0 && violation.maxCoeff(&worst) > rowSlack) {
-      rows.push_back(static_cast<int>(worst));
-      continue;
-    }
-    const auto multipliers = solution.tail(static_cast<Eigen::Index>(rows.size()));
-    Eigen::Index mostNegative = -1;
-    const double threshold = -1e-12 * (1.0 + (multipliers.size() > 0 ? multipliers.cwiseAbs().maxCoeff() : 0.0));
-    if (multipliers.size() > 0 && multipliers.minCoeff(&mostNegative) < threshold) {
-      rows.erase(rows.begin() + mostNegative);
-      continue;
-    }
-    if (balanceRows > 0 && (p.balance * F - p.balanceTarget).cwiseAbs().maxCoeff() > rowSlack) return std::nullopt;
-    RunOutcome outcome;
-    outcome.converged = true;
-    outcome.hasMultipliers = true;
-    if (balanceRows > 0) outcome.equalityMultipliers = solution.segment<6>(n);
-    outcome.inequalityMultipliers.setZero(p.inequality.rows());
-    for (std::size_t a = 0; a < rows.size(); ++a)
-      outcome.inequalityMultipliers[rows[a]] = std::max(multipliers[static_cast<Eigen::Index>(a)], 0.0);
-    x = F;
-    return outcome;
+  const auto inequalities = static_cast<int>(p.inequality.rows());
+  DualActiveSetQp qp;
+  qp.resize(n, balanceRows, inequalities);
+  qp.hessian = p.hessian;
+  qp.gradient = p.gradient;
+  if (balanceRows > 0) {
+    qp.equality = p.balance;
+    qp.equalityTarget = p.balanceTarget;
   }
-  return std::nullopt;
+  qp.inequality = p.inequality;
+  qp.inequalityBound = p.inequalityBound;
+  qp.inequalityCount = inequalities;
+  constexpr double kViolationTolerance = 1e-13;  // the active-set solver's
+  if (qp.solve(rows, settings.maxIterations, kViolationTolerance) != DualActiveSetQp::Status::Optimal || !qp.x.allFinite())
+    return std::nullopt;
+  RunOutcome outcome;
+  outcome.converged = true;
+  outcome.hasMultipliers = true;
+  if (balanceRows > 0) outcome.equalityMultipliers = qp.equalityMultipliers;
+  outcome.inequalityMultipliers = qp.inequalityMultipliers.head(inequalities).cwiseMax(0.0);
+  outcome.iterations = qp.iterations;
+  x = qp.x;
+  return outcome;
 }
 
-/// The solver's answer polished: on the rows its multipliers hold (OSQP's choice: a row the
-/// solver finds at its bound with a multiplier below 1e-6 of the largest is not held; an
-/// interior-point solver leaves ~1e-8 on rows that are only nearly active), on every row at its
-/// bound (multipliers estimated there, signs enforced), and by crossover from the held rows
-/// (its own multipliers). The candidate that keeps every row with the smallest KKT residual
-/// replaces the answer when that residual is smaller than the answer's. Returns the polished
+/// The solver's answer polished: by crossover from the rows its multipliers hold (OSQP's
+/// choice: a row the solver finds at its bound with a multiplier below 1e-6 of the largest is
+/// not held; an interior-point solver leaves ~1e-8 on rows that are only nearly active), with
+/// the crossover's own multipliers; failing that, on the held rows, then on every row at its
+/// bound (multipliers estimated there, signs enforced). The point replaces the answer when it
+/// keeps every row and its KKT residual is smaller than the answer's. Returns the polished
 /// point's residual, or nothing when the answer stands as solved.
 std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, double band,
                                         const InnerSettings& settings, RunOutcome& outcome, Eigen::VectorXd& x) {
   if (!p.cones.empty() || !x.allFinite()) return std::nullopt;
+  // In the band every point is judged on the band's rows, as the solver and the active-set
+  // method solve it: the optimum may lean on the band's edge, where the balance held at the
+  // band's centre (the simple candidates) is another point, 6e-3 N away on the weight shift.
+  std::optional<ContactProblem> banded;
+  if (balance == BalanceMode::Band) banded = withBandRows(p, band);
+  const ContactProblem& judged = banded ? *banded : p;
   InnerResult before;
-  finishResult(p, x.data(), before);
-  takeMultipliers(p, outcome, before);
-  const double residualBefore = kktResidual(p, before);
+  finishResult(judged, x.data(), before);
+  takeMultipliers(judged, outcome, before);
+  const double residualBefore = kktResidual(judged, before);
   const double largest = before.inequalityMultipliers.size() > 0 ? before.inequalityMultipliers.maxCoeff() : 0.0;
   std::vector<int> held;
   for (const int row : before.activeSet)
@@ -337,26 +329,34 @@ std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode bal
     if (balance != BalanceMode::Dropped && (p.balance * polished - p.balanceTarget).cwiseAbs().maxCoeff() > band + rowSlack)
       return;
     InnerResult after;
-    finishResult(p, polished.data(), after);
+    finishResult(judged, polished.data(), after);
     if (crossed)
-      takeMultipliers(p, *crossed, after);
+      takeMultipliers(judged, *crossed, after);
     else
-      estimateMultipliers(p, after);
-    const double residualAfter = kktResidual(p, after);
+      estimateMultipliers(judged, after);
+    const double residualAfter = kktResidual(judged, after);
     if (!(residualAfter < bestResidual)) return;
     best = polished;
     bestResidual = residualAfter;
     bestCrossed = crossed;
   };
-  consider(solveOnActiveRows(p, balance, held).head(n), std::nullopt);
-  if (held.size() != before.activeSet.size()) consider(solveOnActiveRows(p, balance, before.activeSet).head(n), std::nullopt);
-  // In the band the crossover holds the band's twelve rows as the solver did, as rows: the
-  // optimum may lean on the band's edge, away from its centre (the simple candidates' balance).
+  // The crossover first: where it ends, its point is the QP's own, which the residual cannot
+  // always tell (with near-active rows, estimated multipliers make points 2 J of objective
+  // apart look alike). The simple candidates, if it fails, hold the balance as equalities (at
+  // the band's centre) and the contact rows as found.
   Eigen::VectorXd crossed;
-  if (const std::optional<RunOutcome> crossing = balance == BalanceMode::Band
-                                                     ? crossover(withBandRows(p, band), BalanceMode::Dropped, rowSlack, held, crossed)
-                                                     : crossover(p, balance, rowSlack, held, crossed))
+  if (const std::optional<RunOutcome> crossing =
+          crossover(judged, banded ? BalanceMode::Dropped : balance, settings, held, crossed))
     consider(crossed, crossing);
+  if (best.size() == 0) {
+    const auto contactRows = [&](std::vector<int> rows) {
+      std::erase_if(rows, [&](int row) { return row >= p.inequality.rows(); });
+      return rows;
+    };
+    consider(solveOnActiveRows(p, balance, contactRows(held)).head(n), std::nullopt);
+    if (held.size() != before.activeSet.size())
+      consider(solveOnActiveRows(p, balance, contactRows(before.activeSet)).head(n), std::nullopt);
+  }
   if (best.size() == 0) return std::nullopt;
   x = best;
   if (bestCrossed) {
