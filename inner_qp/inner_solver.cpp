@@ -299,10 +299,17 @@ std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance
 /// not held; an interior-point solver leaves ~1e-8 on rows that are only nearly active), with
 /// the crossover's own multipliers; failing that, on the held rows, then on every row at its
 /// bound (multipliers estimated there, signs enforced). The point replaces the answer when it
-/// keeps every row and its KKT residual is smaller than the answer's. Returns the polished
-/// point's residual, or nothing when the answer stands as solved.
-std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, double band,
-                                        const InnerSettings& settings, RunOutcome& outcome, Eigen::VectorXd& x) {
+/// keeps every row and its KKT residual is smaller than the answer's. Empty where polishing
+/// does not apply (the report model's cones, a non-finite answer).
+struct Polishing {
+  bool replaced = false;  ///< the answer was replaced by the polished point
+  /// The KKT residual the returned point is certified to: the polished point's, or, when the
+  /// answer stands, the answer's own (no candidate did better: a warm start at an exact
+  /// solution of a nearby problem often ends there).
+  double residual = 0.0;
+};
+std::optional<Polishing> polishOnActiveSet(const ContactProblem& p, BalanceMode balance, double band,
+                                           const InnerSettings& settings, RunOutcome& outcome, Eigen::VectorXd& x) {
   if (!p.cones.empty() || !x.allFinite()) return std::nullopt;
   // In the band every point is judged on the band's rows, as the solver and the active-set
   // method solve it: the optimum may lean on the band's edge, where the balance held at the
@@ -357,7 +364,7 @@ std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode bal
     if (held.size() != before.activeSet.size())
       consider(solveOnActiveRows(p, balance, contactRows(before.activeSet)).head(n), std::nullopt);
   }
-  if (best.size() == 0) return std::nullopt;
+  if (best.size() == 0) return Polishing{false, residualBefore};
   x = best;
   if (bestCrossed) {
     outcome.hasMultipliers = true;
@@ -368,7 +375,7 @@ std::optional<double> polishOnActiveSet(const ContactProblem& p, BalanceMode bal
     outcome.hasMultipliers = false;  // estimated at the polished point
     outcome.message += "; polished on its active set";
   }
-  return bestResidual;
+  return Polishing{true, bestResidual};
 }
 
 }  // namespace
@@ -377,7 +384,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
                               InnerResult& r) {
   // Every run of the solver polished when asked (the first solve, the least-slack phase, the
   // objective phase, the re-solve).
-  std::optional<double> lastPolished;  // the last run's polished residual; empty: its answer stands as solved
+  std::optional<Polishing> lastPolished;  // the last run's polishing; empty: not polished
   const NlpRunner run = [&](const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& s,
                             Eigen::VectorXd& x) {
     RunOutcome outcome = solverRun(problem, balance, band, s, x);
@@ -414,7 +421,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     leastSlack.tikhonov = 0.0;
     Eigen::VectorXd y = x.allFinite() ? x : Eigen::VectorXd::Zero(n);
     RunOutcome phase1 = run(leastSlack, BalanceMode::Dropped, 0.0, settings, y);
-    const std::optional<double> leastSlackPolished = lastPolished;
+    const std::optional<Polishing> leastSlackPolished = lastPolished;
     r.leastSlackWrenches = y;
     // The least slack is an answer too: certified by its own KKT conditions, or not trusted.
     InnerResult leastSlackResult;
@@ -460,8 +467,9 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     // √kktTolerance of the data's scale from zero: the sample is treated as feasible and
     // solved again, from the elastic point, as the original problem; its own KKT check
     // then decides (it is never called infeasible on such a slack). A polished least-slack
-    // point is certified to its own, smaller residual, and tells slacks down to √ of that.
-    const double certificate = leastSlackPolished && phase1.converged ? *leastSlackPolished : settings.kktTolerance;
+    // point (or an answer that polishing could not better) is certified to its own, smaller
+    // residual, and tells slacks down to √ of that.
+    const double certificate = leastSlackPolished && phase1.converged ? leastSlackPolished->residual : settings.kktTolerance;
     if (slack.cwiseAbs().maxCoeff() <= std::sqrt(certificate) * scale) {
       diagnostics += "least slack negligible, solved again from the elastic point; ";
       const int before = outcome.iterations;
@@ -476,7 +484,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
   r.balanceSlack = slack;
   takeMultipliers(*solved, outcome, r);
   r.iterations = outcome.iterations;
-  r.polished = lastPolished.has_value();  // of the run whose point is returned
+  r.polished = lastPolished && lastPolished->replaced;  // of the run whose point is returned
   r.message = diagnostics + outcome.message;
   r.kktResidual = kktResidual(p, r);
   // A stop is a solution only where the KKT conditions hold (style.md §9: re-check, never
