@@ -69,8 +69,8 @@ TEST_CASE("polishing: warm-started re-solves at a boundary sample's perturbed st
   // NLP solver warm-started at an exact least-slack point may end there with a residual no
   // candidate betters; that answer is certified to its own residual (not to kktTolerance, which
   // called a 0.05 N m slack negligible, the sample solved again as feasible and `failed` at 9
-  // of the 90 states, and
-  // made SLSQP's Hessian differ from the active-set method's by 61 in 35070).
+  // of the 90 states, and made SLSQP's Hessian differ from the active-set method's by 61 in
+  // 35070).
   const RobotModel robot = loadUrdfFile(test::hrp2().urdf);
   const ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
   std::vector<ContactSurface> contacts;
