@@ -14,33 +14,58 @@
 
 using namespace mcopt;
 
+namespace {
+
+/// HRP-2 on both soles, the left one the reference body at the world origin, the wrench-cone
+/// model: the weight shift's sample problems (scenarios/hrp2_weight_shift.yaml).
+struct TwoSoles {
+  RobotModel robot = loadUrdfFile(test::hrp2().urdf);
+  ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
+  std::vector<ContactSurface> contacts = soles();
+  DynamicsModel model{robot, "l_sole"};
+  DynamicsData data{model};
+  SampleProblem sample{model, contacts, wrenchCone()};
+
+  std::vector<ContactSurface> soles() const {
+    std::vector<ContactSurface> chosen;
+    for (const ContactSurface& s : loadContactSurfaces(test::sourceDir() / "robots/hrp2/contacts.yaml", robot))
+      if (s.name == "l_sole" || s.name == "r_sole") chosen.push_back(s);
+    REQUIRE(chosen.size() == 2);
+    return chosen;
+  }
+  static ContactProblemSettings wrenchCone() {
+    ContactProblemSettings settings;
+    settings.model = ContactModel::WrenchCone;
+    return settings;
+  }
+  /// The sample's inner problem at (q, v, a).
+  const ContactProblem& at(const Eigen::VectorXd& q, const Eigen::VectorXd& v, const Eigen::VectorXd& a) {
+    inverseDynamics(model, data, q, v, a);
+    sample.update(model, data, actuators, contacts, v, a);
+    return sample.problem;
+  }
+};
+
+/// One of a state's arrays (q, v or a) from weight_shift_boundary_states.json.
+Eigen::VectorXd stateVector(const nlohmann::json& state, const char* key) {
+  const std::vector<double> values = state.at(key).get<std::vector<double>>();
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
+}
+
+nlohmann::json boundaryStates() {
+  return test::readJson(test::sourceDir() / "tests/inner_qp/weight_shift_boundary_states.json");
+}
+
+}  // namespace
+
 TEST_CASE("polishing: on the weight shift's infeasible samples SLSQP and Ipopt end on the active-set method's elastic solution",
           "[inner][solvers][polish]") {
-  const RobotModel robot = loadUrdfFile(test::hrp2().urdf);
-  const ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
-  std::vector<ContactSurface> contacts;
-  for (const ContactSurface& s : loadContactSurfaces(test::sourceDir() / "robots/hrp2/contacts.yaml", robot))
-    if (s.name == "l_sole" || s.name == "r_sole") contacts.push_back(s);
-  REQUIRE(contacts.size() == 2);
-  const DynamicsModel model(robot, "l_sole");
-  DynamicsData data(model);
-  ContactProblemSettings settings;
-  settings.model = ContactModel::WrenchCone;
-  SampleProblem sample(model, contacts, settings);
-
+  TwoSoles hrp2;
   InnerSettings polishing;
   polishing.polish = true;
   auto activeSet = makeActiveSetSolver();
-  const nlohmann::json states = test::readJson(test::sourceDir() / "tests/inner_qp/weight_shift_boundary_states.json");
-  for (const nlohmann::json& state : states.at("samples")) {
-    const auto vector = [&](const char* key) {
-      const std::vector<double> values = state.at(key).get<std::vector<double>>();
-      return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
-    };
-    const Eigen::VectorXd q = vector("q"), v = vector("v"), a = vector("a");
-    inverseDynamics(model, data, q, v, a);
-    sample.update(model, data, actuators, contacts, v, a);
-    const ContactProblem& p = sample.problem;
+  for (const nlohmann::json& state : boundaryStates().at("samples")) {
+    const ContactProblem& p = hrp2.at(stateVector(state, "q"), stateVector(state, "v"), stateVector(state, "a"));
     InnerResult reference;
     activeSet->solve(p, reference);
     INFO("iterate " << state.at("iteration") << ", sample " << state.at("sample") << "; active-set: slack "
@@ -71,33 +96,18 @@ TEST_CASE("polishing: warm-started re-solves at a boundary sample's perturbed st
   // called a 0.05 N m slack negligible, the sample solved again as feasible and `failed` at 9
   // of the 90 states, and made SLSQP's Hessian differ from the active-set method's by 61 in
   // 35070).
-  const RobotModel robot = loadUrdfFile(test::hrp2().urdf);
-  const ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
-  std::vector<ContactSurface> contacts;
-  for (const ContactSurface& s : loadContactSurfaces(test::sourceDir() / "robots/hrp2/contacts.yaml", robot))
-    if (s.name == "l_sole" || s.name == "r_sole") contacts.push_back(s);
-  const DynamicsModel model(robot, "l_sole");
-  DynamicsData data(model);
-  ContactProblemSettings settings;
-  settings.model = ContactModel::WrenchCone;
-  SampleProblem sample(model, contacts, settings);
-  const nlohmann::json state =
-      test::readJson(test::sourceDir() / "tests/inner_qp/weight_shift_boundary_states.json").at("perturbed");
-  const auto vector = [&](const char* key) {
-    const std::vector<double> values = state.at(key).get<std::vector<double>>();
-    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size())));
-  };
-  const Eigen::VectorXd q = vector("q"), v = vector("v"), a = vector("a");
-  const int n = robot.jointCount();
+  TwoSoles hrp2;
+  const nlohmann::json state = boundaryStates().at("perturbed");
+  const Eigen::VectorXd q = stateVector(state, "q"), v = stateVector(state, "v"), a = stateVector(state, "a");
+  const int n = hrp2.robot.jointCount();
   InnerSettings polishing;
   polishing.polish = true;
   auto activeSet = makeActiveSetSolver();
   auto slsqp = makeSlsqpSolver(polishing);
-  inverseDynamics(model, data, q, v, a);
-  sample.update(model, data, actuators, contacts, v, a);
+  const ContactProblem& p = hrp2.at(q, v, a);
   InnerResult baseReference, base;
-  activeSet->solve(sample.problem, baseReference);
-  slsqp->solve(sample.problem, base);
+  activeSet->solve(p, baseReference);
+  slsqp->solve(p, base);
   REQUIRE(baseReference.status == InnerStatus::Infeasible);
   REQUIRE(base.status == InnerStatus::Infeasible);
   int same = 0;
@@ -105,11 +115,10 @@ TEST_CASE("polishing: warm-started re-solves at a boundary sample's perturbed st
     Eigen::VectorXd moved[3] = {q, v, a};
     double& component = moved[c / n][c % n];
     component += 1e-6 * std::max(1.0, std::abs(component));
-    inverseDynamics(model, data, moved[0], moved[1], moved[2]);
-    sample.update(model, data, actuators, contacts, moved[1], moved[2]);
+    const ContactProblem& probe = hrp2.at(moved[0], moved[1], moved[2]);
     InnerResult reference = baseReference, polished = base;  // warm starts, as the Hessian's probes
-    activeSet->solve(sample.problem, reference);
-    slsqp->solve(sample.problem, polished);
+    activeSet->solve(probe, reference);
+    slsqp->solve(probe, polished);
     INFO("component " << c << ": active-set " << toString(reference.status) << "; slsqp " << toString(polished.status) << " ("
                       << polished.message << ")");
     CHECK(polished.status == reference.status);
