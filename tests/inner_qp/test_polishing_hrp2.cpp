@@ -64,7 +64,10 @@ TEST_CASE("polishing: on the weight shift's infeasible samples SLSQP and Ipopt e
   InnerSettings polishing;
   polishing.polish = true;
   auto activeSet = makeActiveSetSolver();
-  for (const nlohmann::json& state : boundaryStates().at("samples")) {
+  const nlohmann::json states = boundaryStates();
+  int compared = 0;
+  for (const nlohmann::json& state : states.at("samples")) {
+    ++compared;
     const ContactProblem& p = hrp2.at(stateVector(state, "q"), stateVector(state, "v"), stateVector(state, "a"));
     InnerResult reference;
     activeSet->solve(p, reference);
@@ -85,6 +88,7 @@ TEST_CASE("polishing: on the weight shift's infeasible samples SLSQP and Ipopt e
       CHECK(std::abs(polished.objective - reference.objective) <= 1e-9 * (1.0 + std::abs(reference.objective)));
     }
   }
+  CHECK(compared == 3);
 }
 
 TEST_CASE("polishing: warm-started re-solves at a boundary sample's perturbed states keep its status and wrenches",
@@ -97,7 +101,8 @@ TEST_CASE("polishing: warm-started re-solves at a boundary sample's perturbed st
   // of the 90 states, and made SLSQP's Hessian differ from the active-set method's by 61 in
   // 35070).
   TwoSoles hrp2;
-  const nlohmann::json state = boundaryStates().at("perturbed");
+  const nlohmann::json states = boundaryStates();
+  const nlohmann::json& state = states.at("perturbed");
   const Eigen::VectorXd q = stateVector(state, "q"), v = stateVector(state, "v"), a = stateVector(state, "a");
   const int n = hrp2.robot.jointCount();
   InnerSettings polishing;
