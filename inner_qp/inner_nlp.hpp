@@ -132,6 +132,9 @@ struct RunOutcome {
   double coneSmoothing = 0.0;             ///< δ of the cone form the multipliers belong to (0: quadratic)
 };
 
+/// The result's multipliers: the solver's own (RunOutcome), converted to the conic form, or estimated.
+void takeMultipliers(const ContactProblem& problem, const RunOutcome& outcome, InnerResult& result);
+
 /// x: starting point in, solution out (InnerNlp::variableCount()). Solver-specific choices
 /// (the cone form) are made by the runner from the problem it is given.
 using NlpRunner = std::function<RunOutcome(const ContactProblem& problem, BalanceMode balance, double band,
