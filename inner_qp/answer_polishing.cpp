@@ -1,7 +1,6 @@
 #include "inner_qp/answer_polishing.hpp"
 
 #include <Eigen/QR>
-#include <algorithm>
 #include <vector>
 
 #include "inner_qp/dual_active_set_qp.hpp"
@@ -17,8 +16,7 @@ namespace {
 ///   [H  Eᵀ] [F]   [−c]
 ///   [E  0 ] [λ] = [ e],   E: the balance rows (unless dropped) and the active rows.
 /// Dependent active rows (an unloaded contact at the wrench cone's apex) leave it singular but
-/// consistent; the least-norm solution is one of its solutions.
-/// Returns F and then the multipliers (the balance rows', then the active rows' in their order).
+/// consistent; the least-norm solution is one of its solutions. Returns F.
 Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, const std::vector<int>& rows) {
   const int n = 6 * p.contactCount;
   const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
@@ -37,7 +35,7 @@ Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, 
     rhs[at] = p.inequalityBound[rows[a]];
   }
   kkt.topRightCorner(n, m) = kkt.bottomLeftCorner(m, n).transpose();
-  return kkt.completeOrthogonalDecomposition().solve(rhs);
+  return kkt.completeOrthogonalDecomposition().solve(rhs).head(n);
 }
 
 /// The elastic phase 2's problem with its band −band ≤ B F − target ≤ band as twelve linear
@@ -120,7 +118,6 @@ std::optional<Polishing> polishOnActiveSet(const ContactProblem& p, BalanceMode 
   for (const int row : before.activeSet)
     if (before.inequalityMultipliers[row] > 1e-6 * (1.0 + largest)) held.push_back(row);
   const double rowSlack = settings.tolerance * dataScale(p);
-  const int n = 6 * p.contactCount;
   Eigen::VectorXd best;
   double bestResidual = residualBefore;
   std::optional<RunOutcome> bestCrossed;  // the crossover's outcome, when it is the best
@@ -154,9 +151,9 @@ std::optional<Polishing> polishOnActiveSet(const ContactProblem& p, BalanceMode 
       std::erase_if(rows, [&](int row) { return row >= p.inequality.rows(); });
       return rows;
     };
-    consider(solveOnActiveRows(p, balance, contactRows(held)).head(n), std::nullopt);
+    consider(solveOnActiveRows(p, balance, contactRows(held)), std::nullopt);
     if (held.size() != before.activeSet.size())
-      consider(solveOnActiveRows(p, balance, contactRows(before.activeSet)).head(n), std::nullopt);
+      consider(solveOnActiveRows(p, balance, contactRows(before.activeSet)), std::nullopt);
   }
   if (best.size() == 0) return Polishing{false, residualBefore};
   x = best;
@@ -171,6 +168,5 @@ std::optional<Polishing> polishOnActiveSet(const ContactProblem& p, BalanceMode 
   }
   return Polishing{true, bestResidual};
 }
-
 
 }  // namespace mcopt::inner_detail
