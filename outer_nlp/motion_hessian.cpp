@@ -20,7 +20,9 @@
 // curvature with each output's weight w_o held at the point. Along one state component the
 // weighted output gradient Σ_o w_o ∇y_o is a polynomial of known degree (in q̇, q̈, a force
 // variable) or a trigonometric polynomial (in a revolute joint's angle), so a stencil of
-// that degree differentiates it exactly (derivative_stencil.hpp). The duration's row and
+// that degree differentiates it exactly (derivative_stencil.hpp); a throw's rows, functions
+// of the ball's state (a square root of it), take the flight's analytic curvature and a
+// stencil of the ball's state alone (task_kinematics.hpp). The duration's row and
 // column follow by the chain rule from z_s = (B0 x, B1 x / T, B2 x / T²) and the objective's
 // weight ∝ T:
 //   ∂²L/∂x∂T = Bᵀ (H_s u + ĝ + c ∇E),  ∂²L/∂T² = uᵀ H_s u + gᵀ z'' + 2 c ∇E·u,
@@ -402,7 +404,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       if ((lambda.array() == 0.0).all()) continue;  // no bounded component
       const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
       // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
-      const TaskKind kind = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])].kind;
+      const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
+      const TaskKind kind = task.kind;
       const bool velocity = taskReadsVelocity(kind);
       const int d = velocity ? 2 * n : n;
       auto base = h.base.head(d), gradient = h.gradient.head(d);
@@ -410,6 +413,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
       const bool durationTerms = exact && freeDuration && velocity;
+      // A throw's rows are functions of the ball's state k = (p, v_p): their exact Hessian is the
+      // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (task_kinematics.hpp).
+      const bool throwFlight = exact && (kind == TaskKind::ThrowLanding || kind == TaskKind::ThrowRelease);
+      if (throwFlight) {
+        inverseDynamics(model_, w.data, w.q, w.v, w.a);
+        throwFlightCurvature(model_, w.data, task, lambda, w.task, h.ballWeights, h.stateHessian.topLeftCorner(d, d));
+      }
       if (durationTerms) {  // u = ∂z/∂T = (0, −q̇/T) at the instant, before the probes move q̇
         h.stateByDuration.head(n).setZero();
         h.stateByDuration.segment(n, n) = -w.v / T;
@@ -424,13 +434,21 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           column.setZero();
           for (int m = 0; m < stencil.size(); ++m) {
             component = saved + stencil.offsets[static_cast<std::size_t>(m)];
-            taskOutputs(i, true, w, taskProbe);
-            gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
-            if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+            if (throwFlight) {
+              inverseDynamics(model_, w.data, w.q, w.v, w.a);
+              ballStateGradient(model_, w.data, task, h.ballWeights, w.task, gradient.head(n), gradient.tail(n));
+            } else {
+              taskOutputs(i, true, w, taskProbe);
+              gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
+              if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+            }
             column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
           }
           component = saved;
-          h.stateHessian.col(c).head(d) = column;
+          if (throwFlight)
+            h.stateHessian.col(c).head(d) += column;
+          else
+            h.stateHessian.col(c).head(d) = column;
           continue;
         }
         const double step = differenceStep(saved);

@@ -276,6 +276,8 @@ class MotionProblem final : public NlpProblem {
     // the state and force columns at the sample's point, and C J_W for the rows' curvature.
     Vector6 wrenchWeights = Vector6::Zero();
     Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchJacobian, curvedWrenchJacobian;
+    // A throw's task instant: the weights its flight puts on the ball's state (task_kinematics.hpp).
+    Vector6 ballWeights = Vector6::Zero();
   };
   /// The exact option's stencils (derivative_stencil.hpp): along a joint angle, a velocity, an
   /// acceleration, a force variable of a sample, and a task instant's angle and velocity.

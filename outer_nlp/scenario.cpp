@@ -368,9 +368,6 @@ const std::vector<std::string>& hessianOptionNames() {
 }
 
 std::string exactHessianRefusal(const Scenario& s) {
-  for (const TaskSpec& task : s.tasks)
-    if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease)
-      return "a throw's flight is not polynomial in the state (task '" + task.name + "'); use sample-differences";
   if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
     return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
            "variables, or hessian: sample-differences";

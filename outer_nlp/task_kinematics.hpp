@@ -28,6 +28,8 @@ struct TaskWorkspace {
   MotionDerivative dTwistDq, dTwistDv, dAccelerationDq, dAccelerationDv, dAccelerationDa;
   Eigen::Matrix3Xd comJacobian;
   Eigen::Matrix3Xd velocityDq;  ///< ∂v_p/∂q of a throw's ball
+  /// A throw's exact Hessian: ∂k/∂(q, q̇) of the ball's state k = (p, v_p), and W times it.
+  Eigen::Matrix<double, 6, Eigen::Dynamic> ballJacobian, weightedBallJacobian;
 };
 
 /// Whether the task's quantity depends on q̇ (else on q alone).
@@ -40,5 +42,20 @@ inline bool taskReadsVelocity(TaskKind kind) {
 void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task, bool derivatives,
                   TaskWorkspace& workspace, Vector3& value, Eigen::Ref<Eigen::Matrix3Xd> dq,
                   Eigen::Ref<Eigen::Matrix3Xd> dv);
+
+/// A throw task's rows weighted by their multipliers λ, Σ_i λ_i f_i(k) with k = (p, v_p) the
+/// ball's state, split for the exact Hessian in (q, q̇) (docs/scenarios.md, "The exact
+/// Hessian"): ∇² = J_kᵀ (Σ λ_i ∇²f_i) J_k + Σ_m w_m ∇²k_m, w = Σ λ_i ∇f_i. The flight's own
+/// curvature, the first term, goes to `flightCurvature` (2n × 2n); the weights w on the ball's
+/// state go to `ballWeights`, held at the point while a stencil differentiates
+/// ballStateGradient for the second (p and v_p have a position's and a linear velocity's degrees).
+void throwFlightCurvature(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task,
+                          const Vector3& multipliers, TaskWorkspace& workspace, Vector6& ballWeights,
+                          Eigen::Ref<Eigen::MatrixXd> flightCurvature);
+
+/// wᵀ ∂k/∂q and wᵀ ∂k/∂q̇ of a throw's ball state k = (p, v_p), n entries each.
+void ballStateGradient(const DynamicsModel& model, const DynamicsData& data, const TaskSpec& task,
+                       const Vector6& ballWeights, TaskWorkspace& workspace, Eigen::Ref<Eigen::VectorXd> dq,
+                       Eigen::Ref<Eigen::VectorXd> dv);
 
 }  // namespace mcopt

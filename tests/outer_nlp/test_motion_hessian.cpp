@@ -268,7 +268,8 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
   // differences is at 2.4e-4 on the same kick). The cases cover the report model's squared
   // friction cone (fourth-degree stencils) and the linear pyramid (second-degree), a free
   // duration (the chain rule's row and column), the regularisation, the epigraph, every task
-  // kind, and the single-level formulations with three contacts and a window.
+  // kind, the single-level formulations with three contacts and a window, and the throw's rows
+  // (every optional one bounded) with the ball carried until a fixed or a free release.
   struct Case {
     const char* name;
     const char* scenario;
@@ -285,6 +286,8 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
       {"kick, every task kind, free T", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, true, ContactModel::Report, 0.0},
       {"lean reach, splines", "hrp2_lean_reach.yaml", ContactForces::Splines, false, false, false, ContactModel::WrenchCone, 0.0},
       {"lean reach, variables, free T", "hrp2_lean_reach.yaml", ContactForces::Variables, true, false, false, ContactModel::Report, 0.0},
+      {"throw, one foot, free T (free release)", "hrp2_throw_one_foot.yaml", ContactForces::Bilevel, true, false, false, ContactModel::WrenchCone, 0.0},
+      {"throw, two soles, splines", "hrp2_throw.yaml", ContactForces::Splines, false, false, false, ContactModel::WrenchCone, 0.0},
   };
   int compared = 0;
   for (const Case& c : cases) {
@@ -295,6 +298,15 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
 #endif
     Scenario s = loadScenario(test::sourceDir() / "scenarios" / c.scenario);
     s.samples = c.forces == ContactForces::Bilevel ? 12 : 8;
+    if (s.ball) {
+      // The release (0.6 of the motion) on a sample; every optional row of the throw bounded.
+      s.samples = 11;
+      s.continuation.clear();
+      for (TaskSpec& t : s.tasks) {
+        if (t.kind == TaskKind::ThrowLanding) t.lower[2] = 0.1, t.upper[2] = 3.0;  // flight time [s]
+        if (t.kind == TaskKind::ThrowRelease) t.lower.head<2>() << 0.5, -1.0, t.upper.head<2>() << 20.0, 1.4;
+      }
+    }
     s.outputSamples = 20;
     s.forceControlPoints = 6;
     s.contactForces = c.forces;
@@ -312,7 +324,7 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
     INFO(c.name << ": " << error);
     CHECK(error <= 1e-6);
   }
-  CHECK(compared == 7);
+  CHECK(compared == 9);
 }
 
 TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file's line", "[outer][hessian][input]") {
@@ -322,17 +334,25 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   lean.contactForces = ContactForces::Bilevel;
   lean.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(lean), Catch::Matchers::Contains("hessian: exact: the bilevel formulation"));
-  // A throw, in the file and in a continuation stage: file:line: field: why.
+  // In the file and in a continuation stage (the bundled throw is bilevel on two soles):
+  // file:line: field: why.
   const test::TempDir dir;
   const std::filesystem::path throwFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir, [](YAML::Node& root) { root["hessian"] = "exact"; },
       "throw.yaml");
   CHECK_THROWS_WITH(loadScenario(throwFile), Catch::Matchers::Contains(throwFile.string() + ":") &&
-                                                 Catch::Matchers::Contains(": hessian: exact: a throw's flight"));
+                                                 Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   const std::filesystem::path stageFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
       [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact}]"); }, "stage.yaml");
-  CHECK_THROWS_WITH(loadScenario(stageFile), Catch::Matchers::Contains("continuation[0].hessian: exact: a throw's flight"));
+  CHECK_THROWS_WITH(loadScenario(stageFile),
+                    Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));
+  // With the wrenches as spline parameters the same throw is accepted: its flight has an exact
+  // Hessian (task_kinematics.hpp).
+  const std::filesystem::path splinesFile = test::scenarioVariant(
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
+      [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
+  CHECK_NOTHROW(loadScenario(splinesFile));
   // The epigraph with a free duration.
   Scenario kickEpigraph = kick(8);
   kickEpigraph.energyForm = EnergyForm::Epigraph;

@@ -1,4 +1,4 @@
-// The throw (formulation.md §10, issue 15): the ballistic flight's exact gradients, the
+// The throw (formulation.md §10, issue 15): the ballistic flight's exact gradients and Hessians, the
 // throw rows and the carried ball through the whole outer problem against central
 // differences (fixed and free duration, so fixed and free release time; double and single
 // support), and the ball's load: Γ with the ball is Γ without it plus Jᵀ m (p̈ − g), until the
@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <random>
 
 #include "common/finite_differences.hpp"
@@ -54,7 +55,7 @@ Vector3 pointPosition(const DynamicsModel& model, const Eigen::VectorXd& q, int 
 
 }  // namespace
 
-TEST_CASE("ballistic flight: it crosses the target's height at the landing point, with exact gradients",
+TEST_CASE("ballistic flight: it crosses the target's height at the landing point, with exact gradients and Hessians",
           "[outer][throw]") {
   std::mt19937 random(3);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -79,6 +80,22 @@ TEST_CASE("ballistic flight: it crosses the target's height at the landing point
     exact << f.flightTimeGradient, f.landingGradient, f.apexGradient, f.speedGradient, f.elevationGradient;
     INFO("trial " << trial);
     CHECK(test::scaledError(exact, fd.topRows(6)) < 1e-7);
+    // Hessians against central differences of the exact gradients.
+    const std::array<const Matrix6*, 6> hessians{&f.flightTimeHessian, &f.landingHessian[0], &f.landingHessian[1],
+                                                 &f.apexHessian, &f.speedHessian, &f.elevationHessian};
+    const Eigen::MatrixXd dGradient = test::centralDifferences(x, 1e-6, [&] {
+      Eigen::MatrixXd gradients(6, 6);
+      const BallisticFlight probe = ballisticFlight(x.head<3>(), x.tail<3>(), height, g);
+      gradients << probe.flightTimeGradient, probe.landingGradient, probe.apexGradient, probe.speedGradient,
+          probe.elevationGradient;
+      return Eigen::VectorXd(gradients.transpose().reshaped());  // quantity k's gradient at 6 k .. 6 k + 5
+    });
+    for (int k = 0; k < 6; ++k) {
+      INFO("quantity " << k);
+      const Matrix6& hessian = *hessians[static_cast<std::size_t>(k)];
+      CHECK((hessian - hessian.transpose()).norm() <= 1e-14 * (1.0 + hessian.norm()));
+      CHECK(test::scaledError(hessian, dGradient.middleRows(6 * k, 6)) < 1e-7);
+    }
   }
   // A ball that never reaches the target's height: the apex row is negative, τ the apex's.
   const BallisticFlight low = ballisticFlight(Vector3(0, 0, 1.0), Vector3(1.0, 0, 0.5), 2.0, g);
