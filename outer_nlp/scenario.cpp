@@ -623,8 +623,10 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
   if (s.hessian == HessianOption::Exact)
     if (const std::string why = exactHessianRefusal(s); !why.empty())
       throw InputError(where(file, root["hessian"], "hessian") + "exact: " + why);
+  // A stage that does not run with the file's formulation meets the check when
+  // `mcopt run --contact-forces` makes it run (at the problem's construction).
   for (std::size_t k = 0; k < s.continuation.size(); ++k)
-    if (s.continuation[k].hessian == HessianOption::Exact)
+    if (s.continuation[k].hessian == HessianOption::Exact && s.continuation[k].runsWith(s.contactForces))
       if (const std::string why = exactHessianRefusal(continuationStage(s, k)); !why.empty()) {
         const std::string field = "continuation[" + std::to_string(k) + "]";
         const YAML::Node stage = root["continuation"][k];
@@ -639,10 +641,7 @@ Scenario withStagesForItsFormulation(const Scenario& scenario) {
   Scenario kept = scenario;
   kept.continuation.clear();
   for (const Scenario::ContinuationStage& stage : scenario.continuation)
-    if (stage.forContactForces.empty() ||
-        std::find(stage.forContactForces.begin(), stage.forContactForces.end(), scenario.contactForces) !=
-            stage.forContactForces.end())
-      kept.continuation.push_back(stage);
+    if (stage.runsWith(scenario.contactForces)) kept.continuation.push_back(stage);
   return kept;
 }
 

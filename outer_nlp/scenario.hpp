@@ -5,6 +5,7 @@
 // validates everything and names file, line and field in every error.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <limits>
@@ -205,6 +206,11 @@ struct Scenario {
     /// `variables` one from converging; docs/scenarios.md, "Multi-contact"), and
     /// `mcopt run --contact-forces` chooses the formulation after the file is read.
     std::vector<ContactForces> forContactForces;
+    /// Whether the stage runs with that formulation.
+    bool runsWith(ContactForces forces) const {
+      return forContactForces.empty() ||
+             std::find(forContactForces.begin(), forContactForces.end(), forces) != forContactForces.end();
+    }
   };
   std::vector<ContinuationStage> continuation;
 };

@@ -353,6 +353,19 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
       [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
   CHECK_NOTHROW(loadScenario(splinesFile));
+  // A stage for the other formulations alone is not refused for the file's bilevel, and is
+  // for bilevel.
+  const std::filesystem::path otherFormulation = test::scenarioVariant(
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
+      [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [splines]}]"); },
+      "other.yaml");
+  CHECK_NOTHROW(loadScenario(otherFormulation));
+  const std::filesystem::path bilevelStage = test::scenarioVariant(
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
+      [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [bilevel]}]"); },
+      "bilevel.yaml");
+  CHECK_THROWS_WITH(loadScenario(bilevelStage),
+                    Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));
   // The epigraph with a free duration.
   Scenario kickEpigraph = kick(8);
   kickEpigraph.energyForm = EnergyForm::Epigraph;
