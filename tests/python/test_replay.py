@@ -36,13 +36,14 @@ def open_page(page, fragment, tmp_path, tag):
               "--window-size=1000,700", "--virtual-time-budget=3000", "--enable-logging=stderr", "--v=0",
               f"--user-data-dir={tmp_path / ('profile-' + tag)}"]
     shot = tmp_path / f"{tag}.png"
-    done = subprocess.run(common + [f"--screenshot={shot}", url], capture_output=True, text=True, timeout=120)
+    # One launch takes both the screenshot and the DOM after the virtual-time budget (Debian's
+    # headless Chromium does both in one run; two launches a page cost the CI ~2 s each).
+    done = subprocess.run(common + [f"--screenshot={shot}", "--dump-dom", url], capture_output=True, text=True,
+                          timeout=120)
     assert shot.exists(), done.stderr[-2000:]
     console = [l for l in done.stderr.splitlines() if ":CONSOLE" in l]
-    dom = subprocess.run(common + ["--dump-dom", url], capture_output=True, text=True, timeout=120)
-    console += [l for l in dom.stderr.splitlines() if ":CONSOLE" in l]
-    match = re.search(r'<pre id="mcopt-state"[^>]*>(.*?)</pre>', dom.stdout, re.S)
-    assert match and match.group(1), "the page reported no state (it did not render):\n" + dom.stderr[-2000:]
+    match = re.search(r'<pre id="mcopt-state"[^>]*>(.*?)</pre>', done.stdout, re.S)
+    assert match and match.group(1), "the page reported no state (it did not render):\n" + done.stderr[-2000:]
     image = matplotlib.image.imread(shot)[:, :, :3]
     return json.loads(match.group(1)), image, console
 
