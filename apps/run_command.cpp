@@ -13,6 +13,7 @@
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -93,7 +94,10 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 }
 
 int runMotion(const RunOptions& o) {
-  Scenario scenario = loadScenario(o.scenario);
+  // The formulation first: the file's checks that depend on it see the one that will run.
+  std::optional<ContactForces> contactForces;
+  if (!o.contactForces.empty()) contactForces = parseContactForces(o.contactForces);
+  Scenario scenario = loadScenario(o.scenario, contactForces);
   applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian});
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";

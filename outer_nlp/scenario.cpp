@@ -311,7 +311,8 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
     }
   }
 }
-Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file);
+Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
+                      std::optional<ContactForces> contactForces);
 
 }  // namespace
 
@@ -379,15 +380,19 @@ std::string exactHessianRefusal(const Scenario& s) {
   return {};
 }
 
-Scenario loadScenario(const std::filesystem::path& file) { return loadScenario(yaml::loadFile(file), file); }
+Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces) {
+  return loadScenario(yaml::loadFile(file), file, contactForces);
+}
 
-Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file) {
-  return yaml::reading(file, [&] { return readScenario(root, file); });
+Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
+                      std::optional<ContactForces> contactForces) {
+  return yaml::reading(file, [&] { return readScenario(root, file, contactForces); });
 }
 
 namespace {
 
-Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file) {
+Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
+                      std::optional<ContactForces> contactForces) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
   yaml::rejectUnknownKeys(file, root, "",
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
@@ -528,6 +533,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file)
       throw InputError(where(file, node, "contact_forces") + e.what());
     }
   }
+  if (contactForces) s.contactForces = *contactForces;
   if (root["force_control_points"])
     s.forceControlPoints = integerField(file, root["force_control_points"], "force_control_points", 4);
   if (root["inner"]) readInnerSettings(file, root["inner"], s);

@@ -234,8 +234,10 @@ std::string exactHessianRefusal(const Scenario& scenario);
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws
 /// InputError "file:line: field: what" for unknown keys, wrong types, unknown bodies, joints
-/// or postures, and impossible numbers.
-Scenario loadScenario(const std::filesystem::path& file);
+/// or postures, and impossible numbers. `contactForces`, when set, replaces the file's
+/// `contact_forces` before the checks that depend on it (`mcopt run --contact-forces`: a file
+/// whose `hessian: exact` the bilevel formulation refuses is accepted with `splines`).
+Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces = std::nullopt);
 /// (A scenario already parsed as YAML: outer_nlp/scenario_yaml.hpp.)
 
 /// The fields that name side files, relative to the scenario's folder: a copy of the scenario

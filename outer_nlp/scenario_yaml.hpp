@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "outer_nlp/scenario.hpp"
@@ -23,6 +24,7 @@ void checkThrowTask(const std::filesystem::path& file, const YAML::Node& node, c
 
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.
-Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file);
+Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
+                      std::optional<ContactForces> contactForces = std::nullopt);
 
 }  // namespace mcopt

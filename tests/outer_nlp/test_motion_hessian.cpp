@@ -353,6 +353,11 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
       [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
   CHECK_NOTHROW(loadScenario(splinesFile));
+  // The formulation a run chooses (`mcopt run --contact-forces`) is the one checked.
+  CHECK_NOTHROW(loadScenario(throwFile, ContactForces::Splines));
+  CHECK_THROWS_WITH(loadScenario(splinesFile, ContactForces::Bilevel),
+                    Catch::Matchers::Contains(splinesFile.string() + ":") &&
+                        Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   // A stage for the other formulations alone is not refused for the file's bilevel, and is
   // for bilevel.
   const std::filesystem::path otherFormulation = test::scenarioVariant(
