@@ -629,8 +629,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (s.hessian == HessianOption::Exact)
     if (const std::string why = exactHessianRefusal(s); !why.empty())
       throw InputError(where(file, root["hessian"], "hessian") + "exact: " + why);
-  // A stage that does not run with the file's formulation meets the check when
-  // `mcopt run --contact-forces` makes it run (at the problem's construction).
+  // Only the stages that run, with the run's formulation (the file's, or `contactForces`
+  // from `mcopt run --contact-forces`): a stage for `splines` alone is no bilevel run's.
   for (std::size_t k = 0; k < s.continuation.size(); ++k)
     if (s.continuation[k].hessian == HessianOption::Exact && s.continuation[k].runsWith(s.contactForces))
       if (const std::string why = exactHessianRefusal(continuationStage(s, k)); !why.empty()) {
