@@ -28,8 +28,16 @@ namespace {
 struct ScenarioHandle {
   std::filesystem::path file;
   YAML::Node root;  ///< the scenario's fields as read and changed; side files relative to `file`
+  /// The formulation chosen when it was opened, over the file's: as `mcopt run --contact-forces`,
+  /// it is the one the file's checks see (a bilevel file with `hessian: exact` opens for splines).
+  std::optional<ContactForces> contactForces;
   Scenario scenario;
 };
+
+std::optional<ContactForces> formulationArgument(const std::optional<std::string>& name) {
+  if (!name) return std::nullopt;
+  return parseContactForces(*name);
+}
 
 /// A YAML scalar as the Python value it reads as: int, float, bool, None or str.
 py::object scalarToPython(const YAML::Node& node) {
@@ -125,7 +133,10 @@ py::dict iterationDict(const IterationRecord& h, const MotionProblem& problem) {
 py::dict run(const ScenarioHandle& s, const py::object& progress, const std::optional<std::filesystem::path>& out,
              const std::optional<int>& maxIterations, const std::optional<std::string>& contactForces,
              const std::optional<bool>& configurationOptimisation, const std::optional<std::string>& hessian) {
-  Scenario scenario = s.scenario;
+  // Another formulation than the one it was opened with is checked against the file as the
+  // command line's is (loadScenario's contactForces): the file's checks see the run's formulation.
+  const std::optional<ContactForces> forces = formulationArgument(contactForces);
+  Scenario scenario = forces && forces != s.contactForces ? loadScenario(s.root, s.file, forces) : s.scenario;
   ScenarioOverrides overrides;
   if (maxIterations) overrides.maxIterations = *maxIterations;
   if (contactForces) overrides.contactForces = *contactForces;
@@ -181,14 +192,18 @@ as a sweep names them (docs/studies.md): `s["samples"] = 40`, `s["tasks[kick].ta
 `s["inner.solver"] = "slsqp"`. Every change is validated by the scenario loader at once; a
 refused value raises mcopt.InputError with the loader's message and leaves the scenario as it
 was. `run()` optimises it as `mcopt run` does.)doc")
-      .def(py::init([](const std::filesystem::path& file) {
+      .def(py::init([](const std::filesystem::path& file, const std::optional<std::string>& contactForces) {
              auto s = std::make_shared<ScenarioHandle>();
              s->file = file;
+             s->contactForces = formulationArgument(contactForces);
              s->root = yaml::loadFile(file);
-             s->scenario = loadScenario(s->root, file);
+             s->scenario = loadScenario(s->root, file, s->contactForces);
              return s;
            }),
-           py::arg("file"), "Reads and validates a scenario file (errors as `mcopt run` reports them).")
+           py::arg("file"), py::arg("contact_forces") = py::none(),
+           "Reads and validates a scenario file (errors as `mcopt run` reports them). `contact_forces`: "
+           "'bilevel', 'splines' or 'variables' over the file's, as `mcopt run --contact-forces`, "
+           "before the file's checks (a bilevel file with `hessian: exact` opens with 'splines').")
       .def_property_readonly("file", [](const ScenarioHandle& s) { return s.file; }, "the scenario file (side files are relative to it)")
       .def_property_readonly("robot", [](const ScenarioHandle& s) {
         return std::make_shared<RobotHandle>(s.scenario.robot, s.scenario.actuators,
@@ -217,7 +232,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
               throw py::key_error(path + ": " + e.what());
             }
             try {
-              s.scenario = loadScenario(changed, s.file);
+              s.scenario = loadScenario(changed, s.file, s.contactForces);
             } catch (const InputError& e) {
               throw InputError(refusal(e.what(), s.file, path, node));
             }

@@ -13,6 +13,7 @@ import mcopt
 from conftest import SOURCE, assert_same, cli_error, run_cli
 
 KICK = SOURCE / "scenarios" / "hrp2_kick.yaml"
+THROW = SOURCE / "scenarios" / "hrp2_throw.yaml"  # bilevel on two soles
 # Wall-clock times and the scenario's own path differ between two runs of the same problem.
 UNTIMED = ("timings", "seconds", "elapsed_seconds", "scenario", "contact_surfaces")
 
@@ -105,6 +106,34 @@ def test_the_hessian_override_equals_the_cli(mcopt_exe, tmp_path):
     assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
     with pytest.raises(mcopt.InputError, match="--hessian"):
         s.run(hessian="newton")
+
+
+def test_the_chosen_formulation_is_the_one_the_files_checks_see(mcopt_exe, tmp_path):
+    """As `mcopt run --contact-forces`: `hessian: exact` is refused for the bilevel formulation
+    with environment contacts, so the bundled throw with it opens for splines, and is refused
+    again when run as bilevel, with the CLI's message."""
+    s = mcopt.Scenario(THROW, contact_forces="splines")
+    assert s.contact_forces == "splines" and s["contact_forces"] == "bilevel"  # a choice, not a field
+    s["hessian"] = "exact"  # checked for splines: accepted
+    s.save(tmp_path / "exact.yaml")
+    message = cli_error(mcopt_exe, "run", tmp_path / "exact.yaml", "--out", tmp_path / "o")
+    assert "hessian: exact: the bilevel formulation" in message
+    with pytest.raises(mcopt.InputError) as refused:
+        mcopt.Scenario(tmp_path / "exact.yaml")
+    assert str(refused.value) == message
+    opened = mcopt.Scenario(tmp_path / "exact.yaml", contact_forces="splines")
+    with pytest.raises(mcopt.InputError) as as_bilevel:
+        opened.run(contact_forces="bilevel")
+    assert str(as_bilevel.value) == message
+    # Past the checks, it is the CLI's run with the same choice (iterate 0 alone).
+    run_cli(mcopt_exe, "run", tmp_path / "exact.yaml", "--contact-forces", "splines", "--max-iterations", 0,
+            "--out", tmp_path / "cli", check=False)
+    cli = json.loads((tmp_path / "cli" / "result.json").read_text())
+    result = opened.run(max_iterations=0)
+    assert result["solver"]["hessian"] == "exact" == cli["solver"]["hessian"]
+    assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
+    with pytest.raises(mcopt.InputError, match="unknown contact-force formulation 'springs'"):
+        mcopt.Scenario(THROW, contact_forces="springs")
 
 
 def test_progress_returning_false_stops_with_the_last_iterate():
