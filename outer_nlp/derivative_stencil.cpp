@@ -37,6 +37,13 @@ DerivativeStencil polynomialStencil(int degree, double step) {
   return antisymmetric(offsets, A.fullPivLu().solve(rhs));
 }
 
+DerivativeStencil affineStencil(double step) {
+  if (!(step > 0.0)) throw std::invalid_argument("affineStencil: step must be positive");
+  DerivativeStencil s;
+  s.offsets = {step}, s.weights = {1.0 / step}, s.centre = -1.0 / step;
+  return s;
+}
+
 DerivativeStencil trigonometricStencil(int degree) {
   if (degree < 1) throw std::invalid_argument("trigonometricStencil: degree must be at least 1");
   const int K = degree;

@@ -4,15 +4,23 @@
 // docs/scenarios.md, "Hessian and convergence"): along one state component a sample's
 // weighted output gradient is a polynomial of known degree in a velocity, an acceleration or
 // a force variable, and a trigonometric polynomial of known degree in a revolute joint's angle
-// (rigid motions are first-degree in cos q and sin q). f'(0) = Σ_m weight_m f(offset_m).
+// (rigid motions are first-degree in cos q and sin q).
+// f'(0) = centre f(0) + Σ_m weight_m f(offset_m).
 #include <vector>
 
 namespace mcopt {
 
 struct DerivativeStencil {
-  std::vector<double> offsets, weights;  ///< same size; offset 0 never appears (its weight is 0)
+  std::vector<double> offsets, weights;  ///< same size; offset 0 never appears (its weight is `centre`)
+  /// The weight of f(0): zero for the central stencils. One f(0) serves every direction of a
+  /// point, so a one-sided stencil costs one evaluation a direction where a central one costs two.
+  double centre = 0.0;
   int size() const { return static_cast<int>(offsets.size()); }
 };
+
+/// The one-sided difference (f(h) − f(0)) / h: exact for every affine function. `step` h > 0;
+/// throws std::invalid_argument for h ≤ 0.
+DerivativeStencil affineStencil(double step);
 
 /// Central differences at ±h, ±2h, … ±M h with M = ⌈degree / 2⌉ (at least 1): exact for every
 /// polynomial of degree ≤ 2M. `step` h > 0 in the variable's unit; any h is exact in exact

@@ -141,7 +141,18 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
   }
   if (throughWrenches)  // their rows' weights are on the wrenches now
     h.fixedWeights.segment(outputs_.referenceRow(0), outputs_.rowsPerContact * (1 + outputs_.contacts)).setZero();
-  auto column = h.column.head(d), gradient = h.gradient.head(d);
+  // Σ_o w_o ∇y_o at the probed state (and the wrench weights' share): what the stencils difference.
+  auto probeGradient = [&](Eigen::Ref<Eigen::VectorXd> gradient) {
+    sampleOutputs(s, h.probeX, true, w, probe);
+    outputGradient(probe, h.fixedWeights, gradient);
+    if (throughWrenches) {
+      auto J = h.wrenchJacobian.leftCols(d);
+      referenceWrenchJacobian(s, w, J);
+      gradient.noalias() += J.transpose() * h.wrenchWeights;
+    }
+  };
+  auto column = h.column.head(d), gradient = h.gradient.head(d), centre = h.centreGradient.head(d);
+  probeGradient(centre);  // f(0) of the one-sided stencils (affine directions)
   for (int c = 0; c < d; ++c) {
     double* component = c < n           ? &w.q[c]
                         : c < 2 * n     ? &w.v[c - n]
@@ -152,16 +163,10 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
                                        : c < 3 * n ? exactStencils_.acceleration
                                                    : exactStencils_.force;
     const double saved = *component;
-    column.setZero();
+    column = stencil.centre * centre;
     for (int m = 0; m < stencil.size(); ++m) {
       *component = saved + stencil.offsets[static_cast<std::size_t>(m)];
-      sampleOutputs(s, h.probeX, true, w, probe);
-      outputGradient(probe, h.fixedWeights, gradient);
-      if (throughWrenches) {
-        auto J = h.wrenchJacobian.leftCols(d);
-        referenceWrenchJacobian(s, w, J);
-        gradient.noalias() += J.transpose() * h.wrenchWeights;
-      }
+      probeGradient(gradient);
       column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
     }
     *component = saved;
@@ -257,6 +262,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
       h.fixedWeights.setZero(outputs), h.zeroWeights.setZero(outputs), h.column.setZero(largest);
+      h.centreGradient.setZero(largest);
       h.objectiveGradient.setZero(largest), h.stateByDuration.setZero(largest), h.durationRow.setZero(largest);
       h.wrenchJacobian.setZero(6, largest), h.curvedWrenchJacobian.setZero(6, largest);
     }

@@ -268,9 +268,10 @@ class MotionProblem final : public NlpProblem {
     Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
     // The exact option: outputs' weights held at the sample's point, a column being summed,
-    // zero multipliers (the objective's own gradient), and the duration's row in the state
+    // the held-weight gradient at the point itself (the one-sided stencils' f(0)), zero
+    // multipliers (the objective's own gradient), and the duration's row in the state
     // (dz/dT, ∂²L/∂z∂T) with its diagonal entry ∂²L/∂T².
-    Eigen::VectorXd fixedWeights, zeroWeights, column, objectiveGradient, stateByDuration, durationRow;
+    Eigen::VectorXd fixedWeights, zeroWeights, column, centreGradient, objectiveGradient, stateByDuration, durationRow;
     double durationCurvature = 0.0;
     // The rows quadratic in the wrench enter through W_ref: its held weights ω, its Jacobian in
     // the state and force columns at the sample's point, and C J_W for the rows' curvature.

@@ -1,5 +1,6 @@
 // The exact Hessian's stencils (outer_nlp/derivative_stencil.hpp): exact, to rounding, on
-// every polynomial / trigonometric polynomial of their degree, at any point and step — and
+// every polynomial / trigonometric polynomial of their degree (a line for the one-sided
+// stencil), at any point and step — and
 // wrong one degree above, so that a degree understated in motion_hessian.cpp cannot pass.
 #include <catch2/catch.hpp>
 
@@ -14,7 +15,7 @@ namespace {
 
 template <class Function>
 double apply(const DerivativeStencil& s, double at, Function&& f) {
-  double sum = 0.0;
+  double sum = s.centre * f(at);
   for (int m = 0; m < s.size(); ++m) sum += s.weights[static_cast<std::size_t>(m)] * f(at + s.offsets[static_cast<std::size_t>(m)]);
   return sum;
 }
@@ -62,6 +63,15 @@ TEST_CASE("derivative stencils: exact on their degree, not above", "[outer][hess
       CHECK(std::abs(apply(trig, at, trigonometric(degree + 1)) - trigonometricSlope(degree + 1)) > 1e-6);
     }
   }
+  // The one-sided stencil of the affine directions (q̈, force variables): exact on a line at
+  // any step, wrong on a parabola.
+  for (const double step : {0.3, 1.0, 4.0}) {
+    const DerivativeStencil affine = affineStencil(step);
+    const double at = 0.8;
+    CHECK(apply(affine, at, [](double x) { return 2.5 - 1.75 * x; }) == Approx(-1.75).epsilon(1e-14));
+    CHECK(std::abs(apply(affine, at, [](double x) { return 2.5 - 1.75 * x + 0.5 * x * x; }) - (-1.75 + at)) > 1e-3);
+  }
+  CHECK_THROWS(affineStencil(0.0));
   CHECK_THROWS(polynomialStencil(0, 1.0));
   CHECK_THROWS(polynomialStencil(2, 0.0));
   CHECK_THROWS(trigonometricStencil(0));
