@@ -397,6 +397,9 @@ TEST_CASE("exact Hessian: entry by entry where differences can tell, on a smooth
   const Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 23);
   const int curved = problem.nonlinearVariableCount();
   for (const bool withConstraints : {false, true}) {
+#ifdef MCOPT_UNDER_SANITIZERS
+    if (!withConstraints) continue;  // the objective's Hessian is part of the Lagrangian's; Release runs both
+#endif
     const Eigen::VectorXd lambda =
         withConstraints ? randomMultipliers(problem, 31) : Eigen::VectorXd::Zero(problem.constraintCount());
     Eigen::VectorXd values;
