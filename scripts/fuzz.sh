@@ -20,25 +20,22 @@ cmake --preset fuzz -S "$root" >/dev/null
 cmake --build "$root/build/fuzz" --target "${targets[@]/#/fuzz_}"
 
 build="$root/build/fuzz"
-# Third-party leaks only (urdfdom's, on files it rejects): tests/fuzz/lsan.supp says which.
 export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 mkdir -p "$build/findings"
-status=0
-summary=()
-for t in "${targets[@]}"; do
-  exe="$build/tests/fuzz/fuzz_$t"
+
+# One target: its regression inputs, then SECONDS of fuzzing. Prints its summary line to
+# $build/fuzz_<target>.summary and exits non-zero on a finding.
+fuzz_target() {
+  local t="$1" exe="$build/tests/fuzz/fuzz_$1" log="$build/fuzz_$1.log" summary="$build/fuzz_$1.summary"
+  local common=(-timeout=10 -rss_limit_mb=2048 -close_fd_mask=1 "-artifact_prefix=$build/findings/$t-")
   mkdir -p "$build/corpus/$t"
-  log="$build/fuzz_$t.log"
-  common=(-timeout=10 -rss_limit_mb=2048 -close_fd_mask=1 "-artifact_prefix=$build/findings/$t-")
   if [ -d "$root/tests/fuzz/regressions/$t" ] && [ -n "$(ls -A "$root/tests/fuzz/regressions/$t")" ]; then
-    echo "fuzz: $t: regression inputs"
     if ! "$exe" "${common[@]}" "$root/tests/fuzz/regressions/$t"/* > "$build/fuzz_$t.regressions.log" 2>&1; then
-      echo "fuzz: $t: a regression input fails again: $build/fuzz_$t.regressions.log"
-      status=1
-      continue
+      printf '%-16s a regression input fails again: %s\n' "$t" "$build/fuzz_$t.regressions.log" > "$summary"
+      return 1
     fi
   fi
-  echo "fuzz: $t: $seconds s"
+  local result status=0
   if "$exe" "${common[@]}" -max_total_time="$seconds" -print_final_stats=1 \
        "$build/corpus/$t" "$root/tests/fuzz/corpus/$t" > "$log" 2>&1; then
     result="no finding"
@@ -46,10 +43,28 @@ for t in "${targets[@]}"; do
     result="FINDING (see $log and $build/findings/)"
     status=1
   fi
+  local runs rate
   runs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)"
   rate="$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)"
-  summary+=("$(printf '%-16s %12s executions %8s /s  %s' "$t" "${runs:-?}" "${rate:-?}" "$result")")
+  printf '%-16s %12s executions %8s /s  %s\n' "$t" "${runs:-?}" "${rate:-?}" "$result" > "$summary"
+  return $status
+}
+
+# libFuzzer runs a target on one core: the targets run side by side, as many at a time as
+# there are cores, so that CI's SECONDS a target take SECONDS × targets / cores of its time.
+cores="$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"
+status=0
+running=()
+for t in "${targets[@]}"; do
+  echo "fuzz: $t: $seconds s"
+  fuzz_target "$t" &
+  running+=($!)
+  if [ ${#running[@]} -ge "$cores" ]; then
+    wait "${running[0]}" || status=1
+    running=("${running[@]:1}")
+  fi
 done
-printf 'fuzz: %s s a target\n' "$seconds"
-printf '  %s\n' "${summary[@]}"
+for pid in "${running[@]}"; do wait "$pid" || status=1; done
+printf 'fuzz: %s s a target, %s at a time\n' "$seconds" "$cores"
+for t in "${targets[@]}"; do printf '  %s' "$(cat "$build/fuzz_$t.summary")"; echo; done
 exit $status
