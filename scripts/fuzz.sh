@@ -20,6 +20,7 @@ cmake --preset fuzz -S "$root" >/dev/null
 cmake --build "$root/build/fuzz" --target "${targets[@]/#/fuzz_}"
 
 build="$root/build/fuzz"
+# Third-party leaks only (urdfdom's, on files it rejects): tests/fuzz/lsan.supp says which.
 export LSAN_OPTIONS="suppressions=$root/tests/fuzz/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 mkdir -p "$build/findings"
 
