@@ -43,8 +43,9 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
   return usable ? result.x : guess;
 }
 
-/// `--hessian`: every stage takes the option; a stage that then differs from the scenario in
-/// nothing but its iteration limit would solve the same problem again, so it goes.
+/// `--hessian`: every stage takes the option; a stage that then differs from the next one (or
+/// from the scenario) in nothing but its iteration limit would solve the same problem again,
+/// so it goes and the next one solves it.
 void overrideHessian(Scenario& scenario, const std::string& name) {
   HessianOption hessian;
   try {
@@ -55,7 +56,7 @@ void overrideHessian(Scenario& scenario, const std::string& name) {
   scenario.hessian = hessian;
   std::vector<Scenario::ContinuationStage> kept;
   for (std::size_t k = 0; k < scenario.continuation.size(); ++k)
-    if (!posesScenarioProblem(continuationStage(scenario, k), scenario)) {
+    if (!posesScenarioProblem(continuationStage(scenario, k), continuationStage(scenario, k + 1))) {
       kept.push_back(scenario.continuation[k]);
       kept.back().hessian = hessian;
     }

@@ -93,7 +93,8 @@ def test_run_equals_the_cli(mcopt_exe, tmp_path):
 
 
 def test_the_hessian_override_equals_the_cli(mcopt_exe, tmp_path):
-    # The bundled kick's gauss-newton hand-over stage is dropped by the override on both sides.
+    # The bundled kick's two hand-over stages on the smooth maximum (gauss-newton, then
+    # sample-differences) become one by the override, on both sides, before the epigraph's.
     s = mcopt.Scenario(KICK)
     s["samples"] = 12
     s.save(tmp_path / "kick.yaml")
@@ -102,7 +103,8 @@ def test_the_hessian_override_equals_the_cli(mcopt_exe, tmp_path):
     cli = json.loads((tmp_path / "cli" / "result.json").read_text())
     result = s.run(max_iterations=3, configuration_optimisation=False, hessian="exact")
     assert result["solver"]["hessian"] == "exact" == cli["solver"]["hessian"]
-    assert [stage["hessian"] for stage in result["continuation"]] == ["exact"]
+    assert [stage["hessian"] for stage in result["continuation"]] == ["exact", "exact"]
+    assert [stage["energy_form"] for stage in result["continuation"]] == ["smooth_max", "epigraph"]
     assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
     with pytest.raises(mcopt.InputError, match="--hessian"):
         s.run(hessian="newton")

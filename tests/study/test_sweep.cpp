@@ -118,7 +118,7 @@ TEST_CASE("study: a grid runs through every combination, the first field slowest
 
 TEST_CASE("study: random and Latin-hypercube designs are seeded, in range, and stratified", "[study]") {
   const test::TempDir dir;
-  const std::string fields = "vary:\n  - {field: objective.smoothing, range: [0.001, 1.0], scale: log}\n"
+  const std::string fields = "vary:\n  - {field: objective.acceleration_weight, range: [0.001, 1.0], scale: log}\n"
                              "  - {field: samples, range: [10, 50], integer: true}\n"
                              "  - {field: friction_sharpness, values: [0.5, 1.0, 2.0, 4.0]}\n";
   for (const std::string design : {"random", "latin-hypercube"}) {
