@@ -52,7 +52,8 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
     for label, run in runs.items():
         # --max-iterations 1 bounds each continuation stage (every bundled scenario has two: a
         # Gauss–Newton stage, then sample-differences; the weight shift's first is for the
-        # bilevel formulation alone; the kick's two are on the smooth maximum, then its epigraph).
+        # bilevel formulation alone; the kick has three: those two on the smooth maximum, then
+        # its epigraph form).
         assert run["status"] == "maximum_iterations" and run["iterations"] == run["stages"], label
         stages = 1 if label in ("weight_shift/splines", "weight_shift/variables") else 3 if label.startswith("kick/") else 2
         assert run["stages"] == stages, label
