@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -63,9 +64,10 @@ using mcopt::test::readJson;
 TEST_CASE("run: Ipopt's derivative checker finds no error on the bundled scenario", "[cli][run]") {
   // Forward differences: Ipopt's default step 1e-8 is below the objective's round-off (an
   // energy summed over 3000 powers) and 1e-6 above its curvature; 1e-7 resolves both
-  // (docs/scenarios.md). Checked at the scenario's own start and after configuration
-  // optimisation (a posture with CoM over the sole). Ipopt 3.11's checker costs time
-  // quadratic in the Jacobian (40 s at 100 samples of the smooth maximum; the epigraph form's
+  // (docs/scenarios.md). With the scenario's own end postures and with configuration
+  // optimisation's (a posture with CoM over the sole): they fix the first and last control
+  // points, and Ipopt draws the others across the joints' ranges. Ipopt 3.11's checker costs
+  // time quadratic in the Jacobian (40 s at 100 samples of the smooth maximum; the epigraph form's
   // slack a joint and sample took 88 s at 25): 16 samples here (at 12 one entry, 1.1e-4, was
   // the forward difference's own truncation), every kind of row still present; tests/outer_nlp
   // checks the full sampling against central differences.
@@ -87,6 +89,46 @@ TEST_CASE("run: Ipopt's derivative checker finds no error on the bundled scenari
     INFO(r.output.substr(0, 4000));
     CHECK_THAT(r.output, Contains("Starting derivative checker for first derivatives"));
     CHECK_THAT(r.output, Contains("No errors detected by derivative checker"));
+  }
+}
+
+TEST_CASE("run: Ipopt's second-order derivative checker finds no error on the bundled kick's exact Hessian",
+          "[cli][run]") {
+  // The bundled criterion (the epigraph form) and the smooth maximum of the first stage, with
+  // `hessian: exact`, seen through the driver as Ipopt sees it (lower triangle, obj_factor and
+  // multipliers applied). Ipopt checks at a random draw within point_perturbation_radius of
+  // the start, clipped to the bounds: for the control points a draw across each joint's
+  // range, a fast motion whose dry friction is saturated. Its forward differences err by
+  // h ∂³L / 2, and the friction's third derivative at Ω = 0 is large: at 1e-7 one entry of
+  // 8 samples' check came out at 1.7e-4 (3.4e-4 at 2e-7), at 5e-8 the whole check is clean
+  // (docs/scenarios.md, "Ipopt's derivative checker"). Ipopt 3.11's second-order check costs
+  // rows × variables² × Hessian entries (16 min at 8 samples): two samples here, every kind
+  // of row present; tests/outer_nlp/test_motion_hessian.cpp holds every entry at 100 samples.
+  if (kUnderSanitizers) return;  // 15 s in Release; the sanitizer build runs the Hessian tests
+  const test::TempDir dir;
+  for (const char* objective : {"{energy: epigraph}", "{energy: smooth_max, smoothing: 0.01}"}) {
+    const auto log = dir.path() / "ipopt.txt";
+    const auto scenario = kickVariant(dir, [&](YAML::Node& root) {
+      root["samples"] = 2;
+      root["control_points"] = 7;
+      root["objective"] = YAML::Load(objective);
+      root["hessian"] = "exact";
+      root["continuation"] = YAML::Load("[]");
+      root["limits"]["torque_screening"] = 0;
+      root["solver"] = YAML::Node();
+      root["solver"]["max_iter"] = 0;
+      root["solver"]["derivative_test"] = "second-order";
+      root["solver"]["derivative_test_perturbation"] = 5e-8;
+      root["solver"]["output_file"] = log.string();
+      root["solver"]["file_print_level"] = 5;
+    });
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(dir.path() / "out") +
+                                  " --configuration-optimisation off");
+    std::ifstream in(log);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    INFO(objective << "\n" << text.substr(0, 4000));
+    CHECK_THAT(text, Contains("Starting derivative checker for second derivatives"));
+    CHECK_THAT(text, Contains("No errors detected by derivative checker"));
   }
 }
 
