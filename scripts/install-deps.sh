@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs mcopt's build dependencies from Debian 12 packages. Idempotent:
 # packages already present are skipped, so it is cheap to run before every build.
+# `install-deps.sh --list` prints the packages, one a line, and installs nothing
+# (scripts/check-install-deps.sh checks them against every tool the suite calls).
 set -euo pipefail
 
 packages=(
@@ -21,7 +23,13 @@ packages=(
   libjs-three              # three.js, inlined into the pages of `mcopt replay` (docs/replay.md)
   chromium                 # headless browser of the replay's test
   clang libclang-rt-14-dev libomp-14-dev   # the libFuzzer targets (scripts/fuzz.sh, docs/fuzzing.md)
+  llvm                     # llvm-symbolizer: LeakSanitizer names the frames its suppressions match (tests/fuzz/lsan.supp)
 )
+
+if [ "${1:-}" = --list ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${packages[@]}"; do
