@@ -43,6 +43,7 @@ struct RunOptions {
   std::string hessian;                    ///< "", or a Hessian option: every stage's (ScenarioOverrides)
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
   std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
+  bool strict = false;              ///< refuse a fixed posture the robot cannot hold (exit 2, nothing written)
 };
 
 /// A result's motion (result.json `parameters` by joint, `duration`) as the run's start.
@@ -87,7 +88,7 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
   checkpoint.optimisationSeconds = optimisationSeconds;
   checkpoint.totalSeconds = totalSeconds;
   try {
-    writeCheckpointFile(out, makeRunFiles(problem, checkpoint));
+    writeCheckpointFile(out, makeRunFiles(problem, checkpoint, false));
   } catch (const std::exception& e) {
     std::cerr << "mcopt: warning: checkpoint after iteration " << r.iteration << " not written: " << e.what() << "\n";
   }
@@ -126,10 +127,20 @@ int runMotion(const RunOptions& o) {
   if (scenario.initialMotion) std::cout << "  starting from the motion of " << o.startFrom << "\n";
   double lastCheckpoint = 0.0;
   ScenarioRunEvents events;
-  events.onPosture = [](const std::string& which, const PostureOutcome& p) {
-    std::cout << "  " << which << " posture: " << toString(p.status) << " after " << p.iterations
-              << " iterations, static power " << std::setprecision(4) << p.staticPowerBefore << " → "
-              << p.staticPowerAfter << " W (" << std::setprecision(3) << p.seconds << " s)\n";
+  events.onPostureChecks = [&](const std::vector<PostureCheck>& checks) {
+    std::string refused;
+    for (const PostureCheck& c : checks) {
+      std::cout << "  fixed " << c.message() << (c.holdable() ? "" : "  — CANNOT BE HELD") << "\n";
+      if (!c.holdable()) refused += (refused.empty() ? "" : "; ") + c.message();
+    }
+    if (o.strict && !refused.empty())
+      throw InputError(o.scenario + ": the robot cannot hold the fixed " + refused + " (--strict: nothing is run or written)");
+  };
+  events.onPosture = [&](const std::string& which, const PostureOutcome& p) {
+    std::cout << "  " << which << (scenario.periodic ? " and end" : "") << " posture: " << toString(p.status) << " after "
+              << p.iterations << " iterations, static power " << std::setprecision(4) << p.staticPowerBefore << " → "
+              << p.staticPowerAfter << " W (" << std::setprecision(3) << p.seconds << " s)"
+              << (p.status == OuterStatus::Optimal ? "" : "  — NOT OPTIMAL (warning at the end)") << "\n";
   };
   events.onSolve = [&](const SolveStart& solve) {
     if (solve.joinedTorqueRows > 0)
@@ -197,6 +208,16 @@ int runMotion(const RunOptions& o) {
               << ball->landing.x() << ", " << ball->landing.y() << " m; miss " << ball->missDistance << " m"
               << (record.solver.optimal() ? "" : " (target not reached: the written iterate's miss)") << "\n";
   }
+  if (const std::optional<EnergyBalance>& b = written.balance) {
+    std::cout << std::setprecision(4) << "  energy balance     joints' work " << b->jointWork << " J = ΔE_pot "
+              << b->potentialChange << " + ΔE_kin " << b->kineticChange << " J";
+    if (scenario.ball) std::cout << " + ball " << b->ballEnergy << " J";
+    if (!scenario.contacts.empty()) std::cout << " − contacts' work " << b->contactWork << " J";
+    std::cout << " (residual " << std::setprecision(2) << b->mechanicalResidual() << " J)\n" << std::setprecision(4)
+              << "                     Joule " << b->jouleLosses << " J, friction " << b->frictionDissipation
+              << " J, braking fed back " << -b->braking << " J (" << b->instants << " instants)\n";
+  }
+  for (const std::string& w : written.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   if (!record.reason.empty() && !record.solver.optimal()) std::cerr << "mcopt: run not optimal: " << record.reason << "\n";
   if (record.status == OuterStatus::Interrupted) return kExitInterrupted;
   return record.solver.optimal() ? 0 : kExitNotOptimal;
@@ -228,6 +249,9 @@ Runner addRun(CLI::App& command) {
                      "a result folder (or its result.json): start from its motion instead of the interpolated one; "
                      "configuration optimisation off; with another contact-force formulation its forces from the "
                      "inner problem along it");
+  command.add_flag("--strict", o->strict,
+                   "refuse a scenario whose fixed start or end posture the robot cannot hold at rest (centre of mass "
+                   "outside the support polygon, a static torque beyond its limit): exit 2, nothing written");
   command.add_option("--checkpoint-seconds", o->checkpointSeconds,
                      "write the current iterate (status running) at most this often; 0: every iteration, "
                      "negative: never")

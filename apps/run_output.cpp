@@ -32,7 +32,39 @@ Json numberOrNull(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr);
 
 }  // namespace
 
-RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
+std::string gravityWarning(const EnergyBalance& balance, double energy) {
+  if (!(balance.gravityReleased() > energy)) return "";
+  std::ostringstream what;
+  what << std::setprecision(3) << "the motion draws " << balance.gravityReleased() << " J from gravity, more than its criterion's "
+       << energy << " J: its start is higher than its end. Energies compare between motions that end where they start "
+       << "(end: {same_as: start}; docs/scenarios.md, \"Energy balance\")";
+  return what.str();
+}
+
+nlohmann::ordered_json energyBalanceJson(const EnergyBalance& b) {
+  Json j;
+  j["instants"] = b.instants;
+  j["instants_per_interval"] = b.instantsPerInterval;
+  j["wrenches_between_samples"] = b.wrenchesBetweenSamples;
+  j["joint_work_J"] = b.jointWork;
+  j["joint_power_flow_J"] = b.jointPowerFlow;
+  j["contact_work_J"] = b.contactWork;
+  j["potential_energy_change_J"] = b.potentialChange;
+  j["kinetic_energy_change_J"] = b.kineticChange;
+  j["ball_energy_J"] = b.ballEnergy;
+  j["mechanical_identity_residual_J"] = b.mechanicalResidual();
+  j["rotor_kinetic_energy_change_J"] = b.rotorKineticChange;
+  j["joule_losses_J"] = b.jouleLosses;
+  j["friction_dissipation_J"] = b.frictionDissipation;
+  j["electrical_energy_net_J"] = b.electricalEnergy;
+  j["electrical_identity_residual_J"] = b.electricalResidual();
+  j["energy_positive_J"] = b.positiveEnergy;
+  j["braking_J"] = b.braking;
+  j["gravity_released_J"] = b.gravityReleased();
+  return j;
+}
+
+RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool withEnergyBalance) {
   const Scenario& scenario = problem.scenario();
   const RobotModel& robot = scenario.robot;
   const Eigen::VectorXd parameters = problem.motionParameters(record.x);
@@ -142,6 +174,14 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
                          {"miss_distance_m", b.missDistance},
                          {"miss_outside_target_box_m", b.missOutsideBox}};
   }
+  std::vector<std::string> warnings = record.warnings;
+  if (withEnergyBalance) {
+    files.balance = energyBalance(problem, record.x);
+    result["energy_balance"] = energyBalanceJson(*files.balance);
+    if (const std::string w = gravityWarning(*files.balance, r.energy); !w.empty()) warnings.push_back(w);
+  }
+  result["warnings"] = warnings;
+  files.warnings = warnings;
   result["power"] = matrixToJson(r.power.transpose());
   if (fine)
     result["power_fine"] = {{"time", toJson(r.fineTime)}, {"power", matrixToJson(r.finePower.transpose())}};
@@ -223,7 +263,23 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record) {
     result["solver"]["screening_rounds"] = record.stages.back().rounds;
     result["solver"]["torque_rows_checked_afterwards"] = record.stages.back().omittedTorqueRows;
   }
-  result["configuration_optimisation"] = {{"start", posture(record.start)}, {"end", posture(record.end)}};
+  Json fixed = Json::array();
+  for (const PostureCheck& c : record.postureChecks) {
+    Json torques = Json::array();
+    for (const PostureCheck::TorqueExcess& t : c.torques)
+      torques.push_back({{"joint", t.joint}, {"torque_Nm", t.torque}, {"limit_Nm", t.limit}});
+    fixed.push_back({{"which", c.which},
+                     {"time", c.time},
+                     {"holdable", c.holdable()},
+                     {"contacts", c.contacts},
+                     {"center_of_mass", toJson(c.centerOfMass)},
+                     {"support_margin_m", c.supportMargin},
+                     {"torques_beyond_limits", torques},
+                     {"inner_status", c.innerStatus.empty() ? Json(nullptr) : Json(c.innerStatus)}});
+  }
+  result["fixed_postures"] = fixed;
+  result["configuration_optimisation"] = {{"start", posture(record.start)},
+                                          {"end", scenario.periodic ? Json{{"same_as", "start"}} : posture(record.end)}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},
                        {"total_seconds", record.totalSeconds},

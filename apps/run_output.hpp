@@ -9,7 +9,9 @@
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
+#include "outer_nlp/energy_balance.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/scenario_run.hpp"
 
@@ -22,10 +24,22 @@ struct RunFiles {
   double energy = 0.0;        ///< exact ∫ Σ max(P, 0) dt at the samples
   double maxViolation = 0.0;  ///< the largest violation of any row
   std::optional<ReleaseState> release;  ///< a throw's ball at its release (result.json `release`)
+  std::optional<EnergyBalance> balance;  ///< result.json `energy_balance` (none in a checkpoint)
+  std::vector<std::string> warnings;     ///< result.json `warnings`: the record's and the energy balance's
 };
 
-/// Evaluates the motion of `record.x` (regular and fine samples) and serialises it.
-RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record);
+/// The warning of a motion that draws more energy from gravity than its criterion counts
+/// (empty when it does not).
+std::string gravityWarning(const EnergyBalance& balance, double energy);
+
+/// Where the energy of a motion goes, as result.json's `energy_balance` (docs/scenarios.md,
+/// "Energy balance").
+nlohmann::ordered_json energyBalanceJson(const EnergyBalance& balance);
+
+/// Evaluates the motion of `record.x` (regular and fine samples) and serialises it; with
+/// `withEnergyBalance`, its energy balance on a grid of 10 instants an interval too (a
+/// checkpoint goes without: it is written while Ipopt runs).
+RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool withEnergyBalance = true);
 
 /// Writes the files into `directory` (created if needed), result.json last.
 void writeRunFiles(const std::filesystem::path& directory, const RunFiles& files);

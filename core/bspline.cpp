@@ -1,6 +1,7 @@
 #include "core/bspline.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/errors.hpp"
 
@@ -77,8 +78,8 @@ LocalBasis BSplineBasis::evaluate(double u) const {
   return local;
 }
 
-MotionParametrization::MotionParametrization(int jointCount, int controlPointCount)
-    : joints_(jointCount), basis_(controlPointCount) {
+MotionParametrization::MotionParametrization(int jointCount, int controlPointCount, bool periodic)
+    : joints_(jointCount), basis_(controlPointCount), periodic_(periodic) {
   if (controlPointCount < 7)
     throw InputError("clamped trajectories with rest at both ends need at least 7 control points, got " +
                      std::to_string(controlPointCount));
@@ -87,7 +88,7 @@ MotionParametrization::MotionParametrization(int jointCount, int controlPointCou
 int MotionParametrization::parameterOfControlPoint(int k) const {
   const int n = controlPointCount();
   if (k <= 2) return 0;
-  if (k >= n - 3) return parametersPerJoint() - 1;
+  if (k >= n - 3) return endParameter();
   return k - 2;
 }
 
@@ -107,8 +108,18 @@ Eigen::VectorXd MotionParametrization::interpolatedMotion(const Eigen::Ref<const
                                                           const Eigen::Ref<const Eigen::VectorXd>& end) const {
   const int m = parametersPerJoint();
   Eigen::VectorXd x(parameterCount());
-  for (int j = 0; j < joints_; ++j)
-    for (int k = 0; k < m; ++k) x[j * m + k] = start[j] + (end[j] - start[j]) * k / (m - 1);
+  for (int j = 0; j < joints_; ++j) {
+    if (!periodic_) {
+      for (int k = 0; k < m; ++k) x[j * m + k] = start[j] + (end[j] - start[j]) * k / (m - 1);
+      continue;
+    }
+    // The inner control points 1 … m − 1 of a periodic motion: out to `end` and back, a tent.
+    x[j * m] = start[j];
+    for (int k = 1; k < m; ++k) {
+      const double s = static_cast<double>(k) / m;
+      x[j * m + k] = start[j] + (end[j] - start[j]) * (1.0 - std::abs(2.0 * s - 1.0));
+    }
+  }
   return x;
 }
 

@@ -34,13 +34,19 @@ class BSplineBasis {
 };
 
 /// Maps the free parameters of a joint to its n control points and back (formulation.md §3).
-/// Parameter vector layout: joint-major, x[j·perJoint + k].
+/// Parameter vector layout: joint-major, x[j·perJoint + k]. Per joint: the start posture
+/// (control points 0–2: at rest), the n − 6 inner control points, the end posture (the last
+/// three); `periodic`: the end is the start (one parameter for both, n − 5 a joint), so the
+/// motion returns exactly to where it started.
 class MotionParametrization {
  public:
-  MotionParametrization(int jointCount, int controlPointCount = 9);
+  MotionParametrization(int jointCount, int controlPointCount = 9, bool periodic = false);
   int jointCount() const { return joints_; }
   int controlPointCount() const { return basis_.controlPointCount(); }
-  int parametersPerJoint() const { return basis_.controlPointCount() - 4; }
+  bool periodic() const { return periodic_; }
+  int parametersPerJoint() const { return basis_.controlPointCount() - (periodic_ ? 5 : 4); }
+  /// The parameter (within its joint) of the end posture: the last one, or the start's when periodic.
+  int endParameter() const { return periodic_ ? 0 : parametersPerJoint() - 1; }
   int parameterCount() const { return joints_ * parametersPerJoint(); }
   const BSplineBasis& basis() const { return basis_; }
 
@@ -50,7 +56,8 @@ class MotionParametrization {
   void controlPoints(const Eigen::Ref<const Eigen::VectorXd>& parameters, Eigen::MatrixXd& controlPoints) const;
   /// Parameters that hold a joint still at `posture` (jointCount values).
   Eigen::VectorXd constantMotion(const Eigen::Ref<const Eigen::VectorXd>& posture) const;
-  /// Parameters moving from `start` to `end` with the inner control points spaced linearly.
+  /// Parameters moving from `start` to `end` with the inner control points spaced linearly
+  /// (periodic: from `start` out to `end` at mid-motion and back).
   Eigen::VectorXd interpolatedMotion(const Eigen::Ref<const Eigen::VectorXd>& start,
                                      const Eigen::Ref<const Eigen::VectorXd>& end) const;
   /// Control points of the velocity (a quadratic B-spline): n − 1 per joint,
@@ -61,6 +68,7 @@ class MotionParametrization {
  private:
   int joints_;
   BSplineBasis basis_;
+  bool periodic_ = false;
 };
 
 /// Local dependence of one sample on one joint's free parameters: at most 4 control

@@ -21,6 +21,33 @@ Vector3 centerOfMass(const DynamicsModel& model, const DynamicsData& data) {
   return weighted / mass;
 }
 
+double kineticEnergy(const DynamicsModel& model, const DynamicsData& data) {
+  double energy = 0.0;
+  for (int i = 0; i < model.bodyCount(); ++i) {
+    const BodyInertia& inertia = model.inertias()[i];
+    const Vector3& w = data.angularVelocity[i];
+    // linearVelocity is the velocity of the body point at the world origin.
+    const Vector3 comVelocity = data.linearVelocity[i] + w.cross(data.comPosition[i]);
+    const Vector3 wLocal = data.rotation[i].transpose() * w;
+    energy += 0.5 * inertia.mass * comVelocity.squaredNorm() + 0.5 * wLocal.dot(inertia.inertiaAboutCom * wLocal);
+  }
+  return energy;
+}
+
+double potentialEnergy(const DynamicsModel& model, const DynamicsData& data) {
+  double energy = 0.0;
+  for (int i = 0; i < model.bodyCount(); ++i) energy -= model.inertias()[i].mass * model.gravity().dot(data.comPosition[i]);
+  return energy;
+}
+
+Vector6 pointTwist(const DynamicsData& data, int bodyPosition, const Vector3& pointInWorld) {
+  Vector6 twist;
+  const Vector3& w = data.angularVelocity[static_cast<std::size_t>(bodyPosition)];
+  twist.head<3>() = data.linearVelocity[static_cast<std::size_t>(bodyPosition)] + w.cross(pointInWorld);
+  twist.tail<3>() = w;
+  return twist;
+}
+
 void frameJacobian(const DynamicsModel& model, const DynamicsData& data, int bodyPosition, const Vector3& point,
                    FrameJacobian& jacobian) {
   MCOPT_HOT_PATH_CHECK(bodyPosition >= 0 && bodyPosition < model.bodyCount(), "frameJacobian: no such body");

@@ -16,6 +16,18 @@ RigidTransform framePose(const DynamicsModel& model, const DynamicsData& data, i
 /// Whole-body centre of mass [m], world frame.
 Vector3 centerOfMass(const DynamicsModel& model, const DynamicsData& data);
 
+/// Kinetic energy of the bodies [J]: Σ ½ m |v_c|² + ½ ωᵀ I_c ω from the twists that
+/// inverseDynamics leaves in `data` (the reference body's own twist included).
+double kineticEnergy(const DynamicsModel& model, const DynamicsData& data);
+
+/// Potential energy of the bodies in the model's gravity g [J]: −Σ m gᵀ c, zero at the world
+/// origin (poses from forwardKinematics or inverseDynamics).
+double potentialEnergy(const DynamicsModel& model, const DynamicsData& data);
+
+/// Twist (linear velocity of `pointInWorld`, angular velocity; world axes) of the body at
+/// `bodyPosition`, from the twists inverseDynamics leaves in `data`.
+Vector6 pointTwist(const DynamicsData& data, int bodyPosition, const Vector3& pointInWorld);
+
 /// Twist Jacobian of a frame fixed to a body at `placementInBody`: rows (linear velocity of
 /// the frame origin, angular velocity), world axes; columns: joints in URDF order.
 /// Only joints between the reference body and the frame's body have non-zero columns.

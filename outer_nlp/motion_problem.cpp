@@ -107,7 +107,7 @@ const char* constraintKindName(ConstraintKind kind) {
 MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows)
     : scenario_(scenario),
       model_(scenario.robot, scenario.referenceBody, scenario.referencePose, scenario.gravity),
-      parametrization_(scenario.robot.jointCount(), scenario.controlPoints),
+      parametrization_(scenario.robot.jointCount(), scenario.controlPoints, scenario.periodic),
       samples_(parametrization_, nlpSampleTimes(scenario)),
       taskSamples_(parametrization_, taskInstants(scenario, taskOfInstant_)),
       support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm(),
@@ -413,7 +413,10 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
       upper.segment(j * m, m).setConstant(limit.upper);
     }
     if (scenario_.fixStart) lower[j * m] = upper[j * m] = scenario_.start[j];
-    if (scenario_.fixEnd) lower[j * m + m - 1] = upper[j * m + m - 1] = scenario_.end[j];
+    if (scenario_.fixEnd) {
+      const int end = j * m + parametrization_.endParameter();
+      lower[end] = upper[end] = scenario_.end[j];
+    }
   }
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
   lower.tail(variableCount_ - slackStart_).setZero();
@@ -486,13 +489,61 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
     }
     forces_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
   }
-  if (scenario_.energyForm == EnergyForm::Epigraph) {
-    evaluate(x, false);
-    for (int s = 0; s < samples_.sampleCount(); ++s)
-      for (int j = 0; j < jointCount_; ++j)
-        x[slackIndex(s, j)] = std::max(0.0, blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)]);
-  }
+  setSlacksAtPower(x);
   return x;
+}
+
+void MotionProblem::setSlacksAtPower(Eigen::VectorXd& x) {
+  if (scenario_.energyForm != EnergyForm::Epigraph) return;
+  evaluate(x, false);
+  for (int s = 0; s < samples_.sampleCount(); ++s)
+    for (int j = 0; j < jointCount_; ++j)
+      x[slackIndex(s, j)] = std::max(0.0, blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)]);
+}
+
+Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x) {
+  if (other.scenario_.contactForces != scenario_.contactForces || other.parameterCount_ != parameterCount_ ||
+      (other.forceVariableCount() != 0) != (forceVariableCount() != 0))
+    throw std::invalid_argument("pointWithWrenchesFrom: not the same scenario on another grid");
+  if (!forces_ || scenario_.contactForces == ContactForces::Bilevel) return pointFromMotion(other.motionParameters(x), other.duration(x));
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(variableCount_);
+  y.head(parameterCount_) = other.motionParameters(x);
+  if (durationIsFree()) y[parameterCount_] = other.duration(x);
+  if (scenario_.contactForces == ContactForces::Splines) {
+    if (other.forceVariableCount() != forceVariableCount())
+      throw std::invalid_argument("pointWithWrenchesFrom: force splines of another size");
+    y.segment(forceStart_, forceVariableCount()) = x.segment(other.forceStart_, other.forceVariableCount());
+  } else {
+    // Piecewise linear in time through other's samples, within the carried and the released
+    // parts of a throw apart (the release instant is a sample of both grids, twice).
+    other.evaluate(x, false);
+    const int M = other.samples_.sampleCount(), N = samples_.sampleCount();
+    std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, N));
+    for (int s = 0; s < N; ++s) {
+      const double u = sampleTimes_[static_cast<std::size_t>(s)];
+      const bool carried = loaded_[static_cast<std::size_t>(s)];
+      int before = -1, after = -1;
+      for (int k = 0; k < M; ++k) {
+        if (other.loaded_[static_cast<std::size_t>(k)] != carried) continue;
+        const double uk = other.sampleTimes_[static_cast<std::size_t>(k)];
+        if (uk <= u + 1e-12) before = k;
+        if (uk >= u - 1e-12 && after < 0) after = k;
+      }
+      if (before < 0) before = after;
+      if (after < 0) after = before;
+      const double u0 = other.sampleTimes_[static_cast<std::size_t>(before)], u1 = other.sampleTimes_[static_cast<std::size_t>(after)];
+      const double t = u1 > u0 ? (u - u0) / (u1 - u0) : 0.0;
+      const SampleBlock& b0 = other.blocks_[static_cast<std::size_t>(before)];
+      const SampleBlock& b1 = other.blocks_[static_cast<std::size_t>(after)];
+      for (std::size_t i = 0; i < scenario_.contacts.size(); ++i) {
+        const auto at = 6 * (1 + static_cast<Eigen::Index>(i));
+        wrenches[i].col(s) = (1.0 - t) * b0.wrenches.segment<6>(at) + t * b1.wrenches.segment<6>(at);
+      }
+    }
+    forces_->fit(wrenches, y.segment(forceStart_, forceVariableCount()));
+  }
+  setSlacksAtPower(y);
+  return y;
 }
 
 void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bool derivatives, ThreadWorkspace& w) {

@@ -171,6 +171,12 @@ class MotionProblem final : public NlpProblem {
   Eigen::VectorXd pointFrom(const MotionProblem& other, const Eigen::VectorXd& x) {
     return pointFromMotion(other.motionParameters(x), other.duration(x));
   }
+  /// `other`'s point x (the same scenario on another grid of samples: energy_balance.hpp) as a
+  /// point of this problem with the same motion and the same contact wrenches: the force
+  /// splines copied (their windows and control points do not depend on the grid); the
+  /// `variables` formulation's wrenches, defined at other's samples only, interpolated linearly
+  /// in time (within the ball's carried and released parts apart); slacks at max(P, 0).
+  Eigen::VectorXd pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x);
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
   double duration(const Eigen::VectorXd& x) const {
     return durationIsFree() ? x[parameterCount_] : scenario_.duration.initial;
@@ -315,6 +321,8 @@ class MotionProblem final : public NlpProblem {
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;
   int slackIndex(int sample, int joint) const { return slackStart_ + sample * jointCount_ + joint; }
+  /// The epigraph form's slacks of x at max(P, 0) of x's motion (nothing for the smooth maximum).
+  void setSlacksAtPower(Eigen::VectorXd& x);
   /// The robot's dynamics at sample s: with the ball while it is carried.
   const DynamicsModel& modelOf(int s) const { return loaded_[static_cast<std::size_t>(s)] ? *loadedModel_ : model_; }
 

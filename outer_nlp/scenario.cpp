@@ -505,9 +505,20 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   const YAML::Node startNode = yaml::required(file, root, "start", "");
   const YAML::Node endNode = yaml::required(file, root, "end", "");
   s.start = readPosture(file, startNode, "start", s.robot, postures);
-  s.end = readPosture(file, endNode, "end", s.robot, postures);
   if (startNode["fixed"]) s.fixStart = flag(file, startNode["fixed"], "start.fixed");
-  if (endNode["fixed"]) s.fixEnd = flag(file, endNode["fixed"], "end.fixed");
+  if (endNode.IsMap() && endNode["same_as"]) {
+    // The periodic boundary: the end is the start's posture variables themselves.
+    yaml::rejectUnknownKeys(file, endNode, "end", {"same_as"});
+    const std::string same = yaml::text(file, endNode["same_as"], "end.same_as");
+    if (same != "start")
+      throw InputError(where(file, endNode["same_as"], "end.same_as") + "expected start, got '" + same + "'");
+    s.periodic = true;
+    s.end = s.start;
+    s.fixEnd = s.fixStart;
+  } else {
+    s.end = readPosture(file, endNode, "end", s.robot, postures);
+    if (endNode["fixed"]) s.fixEnd = flag(file, endNode["fixed"], "end.fixed");
+  }
   if (s.positionLimits)
     for (int j = 0; j < s.robot.jointCount(); ++j) {
       const JointLimits& limit = s.robot.joints[static_cast<std::size_t>(j)].limits;

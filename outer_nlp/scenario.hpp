@@ -172,6 +172,9 @@ struct Scenario {
 
   Eigen::VectorXd start, end;      ///< initial guesses for the start and end postures [rad]
   bool fixStart = false, fixEnd = false;
+  /// `end: {same_as: start}`: one posture for both ends (MotionParametrization's periodic
+  /// layout), so the motion returns exactly to where it started; end = start, fixEnd = fixStart.
+  bool periodic = false;
   bool configurationOptimisation = true;
   int configurationIterations = 500;
   /// A given initial motion instead of the interpolation from start to end (`mcopt run

@@ -67,6 +67,19 @@ void overrideHessian(Scenario& scenario, const std::string& name) {
       throw InputError("--hessian: exact: " + why);
 }
 
+/// The warning of a posture whose configuration optimisation did not end optimal (empty when it did).
+std::string postureWarning(const std::string& which, const PostureOutcome& p, const Scenario& scenario) {
+  if (!p.optimised || p.status == OuterStatus::Optimal) return "";
+  std::ostringstream what;
+  what << "configuration optimisation of the " << which << " posture ended " << toString(p.status) << " after "
+       << p.iterations << " iterations";
+  if (p.status == OuterStatus::MaximumIterations)
+    what << " (its cap, initialisation.configuration_iterations: " << scenario.configurationIterations << ")";
+  what << ", static power " << p.staticPowerBefore << " → " << p.staticPowerAfter
+       << " W: the motion starts from a posture that is not the static optimum";
+  return what.str();
+}
+
 }  // namespace
 
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
@@ -96,7 +109,8 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
 
 void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector<double>>& parametersByJoint,
                      double duration, const std::string& origin) {
-  const int n = static_cast<int>(scenario.robot.joints.size()), m = scenario.controlPoints - 4;
+  const int n = static_cast<int>(scenario.robot.joints.size()), m = scenario.controlPoints - (scenario.periodic ? 5 : 4);
+  const int endParameter = scenario.periodic ? 0 : m - 1;
   Scenario::InitialMotion motion;
   motion.parameters.resize(n * m);
   for (int j = 0; j < n; ++j) {
@@ -107,7 +121,7 @@ void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector
     if (static_cast<int>(found->second.size()) != m)
       throw InputError(origin + ": parameters." + name + ": " + std::to_string(found->second.size()) +
                        " spline parameters, the scenario has " + std::to_string(m) + " (control_points " +
-                       std::to_string(scenario.controlPoints) + " − 4)");
+                       std::to_string(scenario.controlPoints) + (scenario.periodic ? " − 5: its end is its start)" : " − 4)"));
     for (int l = 0; l < m; ++l) {
       const double value = found->second[static_cast<std::size_t>(l)];
       if (!std::isfinite(value)) throw InputError(origin + ": parameters." + name + ": not a finite number");
@@ -128,7 +142,7 @@ void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector
     throw InputError(what.str());
   }
   motion.duration = std::clamp(duration, T.lower, T.upper);
-  for (int j = 0; j < n; ++j) scenario.start[j] = motion.parameters[j * m], scenario.end[j] = motion.parameters[j * m + m - 1];
+  for (int j = 0; j < n; ++j) scenario.start[j] = motion.parameters[j * m], scenario.end[j] = motion.parameters[j * m + endParameter];
   scenario.configurationOptimisation = false;
   scenario.initialMotion = std::move(motion);
 }
@@ -136,14 +150,23 @@ void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector
 RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events) {
   const auto clock = std::chrono::steady_clock::now();
   RunRecord record;
+  record.postureChecks = checkFixedPostures(problem);
+  for (const PostureCheck& check : record.postureChecks)
+    if (!check.holdable())
+      record.warnings.push_back("the fixed " + check.message() + ": the robot cannot hold it at rest, so no motion of this problem is feasible");
+  if (events.onPostureChecks) events.onPostureChecks(record.postureChecks);
   Eigen::VectorXd start = scenario.start, end = scenario.end;
   if (scenario.configurationOptimisation) {
     if (!scenario.fixStart) {
       start = optimisePosture(scenario, problem, start, 0.0, events, record.start);
+      if (const std::string w = postureWarning("start", record.start, scenario); !w.empty()) record.warnings.push_back(w);
       if (events.onPosture) events.onPosture("start", record.start);
     }
-    if (!scenario.fixEnd) {
+    if (scenario.periodic) {
+      end = start;  // one posture for both ends
+    } else if (!scenario.fixEnd) {
       end = optimisePosture(scenario, problem, end, scenario.duration.initial, events, record.end);
+      if (const std::string w = postureWarning("end", record.end, scenario); !w.empty()) record.warnings.push_back(w);
       if (events.onPosture) events.onPosture("end", record.end);
     }
   }

@@ -14,6 +14,7 @@
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
+#include "outer_nlp/posture_check.hpp"
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt {
@@ -75,9 +76,17 @@ struct RunRecord {
   std::vector<IterationRecord> history;
   std::vector<StageOutcome> stages;  ///< one per continuation stage, the scenario's own problem last
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
+  /// The fixed postures, checked at rest before anything else (posture_check.hpp).
+  std::vector<PostureCheck> postureChecks;
+  /// What the run should not pass over in silence (result.json `warnings`): a fixed posture the
+  /// robot cannot hold, a posture whose configuration optimisation did not end optimal, …
+  std::vector<std::string> warnings;
 };
 
 struct ScenarioRunEvents {
+  /// The fixed postures have been checked (before anything is optimised); may throw to stop
+  /// the run there (`mcopt run --strict` throws InputError when one cannot be held).
+  std::function<void(const std::vector<PostureCheck>&)> onPostureChecks;
   /// A start or end posture has been optimised ("start" or "end").
   std::function<void(const std::string& which, const PostureOutcome&)> onPosture;
   std::function<void(const SolveStart&)> onSolve;

@@ -96,6 +96,15 @@ Json runThrowAndCheckItsBall(const std::filesystem::path& scenario, const test::
     CHECK(result.at("max_violation").get<double>() <= 1e-6);
     CHECK(miss <= 1e-3);
   }
+  // The energy balance of the motion reached (docs/scenarios.md, "Energy balance"): the joints'
+  // and contacts' work is the robot's change of mechanical energy plus what the ball took away.
+  const Json& balance = result.at("energy_balance");
+  const double ball = balance.at("ball_energy_J").get<double>();
+  const double scale = std::max({std::abs(balance.at("joint_work_J").get<double>()), balance.at("joint_power_flow_J").get<double>(),
+                                 std::abs(balance.at("contact_work_J").get<double>()), std::abs(ball)});
+  INFO("energy balance " << balance.dump());
+  CHECK(ball > 0.0);
+  CHECK(std::abs(balance.at("mechanical_identity_residual_J").get<double>()) <= 1e-4 * scale);
   return result;
 }
 

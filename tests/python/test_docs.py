@@ -8,7 +8,7 @@ import re
 
 SOURCE = pathlib.Path(os.environ["MCOPT_SOURCE_DIR"])
 BUILD = pathlib.Path(os.environ["MCOPT_BUILD_DIR"])
-DOCUMENTS = [SOURCE / "README.md", SOURCE / "DEVELOPERS.md"] + sorted((SOURCE / "docs").glob("*.md"))
+DOCUMENTS = [SOURCE / "README.md", SOURCE / "DEVELOPERS.md"] + sorted((SOURCE / "docs").rglob("*.md"))
 
 BUILD_PATH = re.compile(r"build/release/([A-Za-z0-9_./-]+)")
 SOURCE_PATH = re.compile(r"(?<![\w./-])((?:scripts|scenarios|robots|docs|apps|bench|tests)/[A-Za-z0-9_./-]+)")
