@@ -995,3 +995,52 @@ TEST_CASE("run: --start-from refuses a motion that does not fit the scenario, na
     CHECK_FALSE(std::filesystem::exists(dir.path() / "refused"));
   }
 }
+
+TEST_CASE("run: a fixed posture the robot cannot hold is reported before the run, and --strict refuses it", "[cli][run]") {
+  // The kick's one-foot stance fixed at the half-sitting posture with both hips rolled toward the
+  // right foot: its centre of mass is 4 cm beyond the edge of the left sole that alone carries
+  // the robot. The report names the posture and the margin; the run still starts (here stopped
+  // at once); --strict refuses it.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["start"] = YAML::Load("{posture: half_sitting, fixed: true, offsets: {LLEG_JOINT1: 0.1, LLEG_JOINT5: -0.1, "
+                               "RLEG_JOINT1: 0.1, RLEG_JOINT5: -0.1}}");
+    root["continuation"] = YAML::Load("[]");
+  });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 0");
+  INFO(r.all());
+  CHECK(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("fixed start and end posture (t = 0 s): centre of mass") && Contains("cm OUTSIDE the support polygon of l_sole") &&
+                           Contains("CANNOT BE HELD"));
+  const Json result = readJson(out / "result.json");
+  REQUIRE(result["fixed_postures"].size() == 1);
+  const Json& check = result["fixed_postures"][0];
+  CHECK(check["which"] == "start and end");
+  CHECK(check["holdable"] == false);
+  CHECK(check["support_margin_m"].get<double>() == Approx(-0.041).margin(0.001));
+  CHECK(check["contacts"] == Json::array({"l_sole"}));
+  REQUIRE(!result["warnings"].empty());
+  CHECK_THAT(result["warnings"][0].get<std::string>(), Contains("the robot cannot hold it at rest"));
+  CHECK_THAT(r.errors, Contains("mcopt: warning: the fixed start and end posture"));
+
+  const auto refusedOut = dir.path() / "refused";
+  const auto refused = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(refusedOut) + " --strict");
+  INFO(refused.all());
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains("the robot cannot hold the fixed start and end posture") && Contains("OUTSIDE") &&
+                                 Contains("--strict: nothing is run or written"));
+  CHECK_FALSE(std::filesystem::exists(refusedOut / "result.json"));
+
+  // The same posture where the robot stands on both soles is held, and --strict lets it run.
+  const auto held = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+  }, "held.yaml");
+  const auto ok = test::runMcopt("run " + test::quoted(held) + " --out " + test::quoted(dir.path() / "held") +
+                                 " --max-iterations 0 --strict --configuration-optimisation off");
+  INFO(ok.all());
+  CHECK(ok.exitCode == 4);
+  CHECK_THAT(ok.output, Contains("cm inside the support polygon of l_sole, r_sole"));
+  CHECK(readJson(dir.path() / "held/result.json")["fixed_postures"][0]["holdable"] == true);
+}

@@ -11,6 +11,7 @@
 
 #include "common/test_support.hpp"
 #include "outer_nlp/energy_balance.hpp"
+#include "outer_nlp/posture_check.hpp"
 #include "outer_nlp/motion_problem.hpp"
 
 namespace mcopt {
@@ -143,6 +144,27 @@ TEST_CASE("periodic boundary: the motion ends exactly where it starts, at rest",
     CHECK(lower[j * m] == scenario.start[j]);
     CHECK(upper[j * m] == scenario.start[j]);
   }
+}
+
+}  // namespace mcopt
+
+namespace mcopt {
+
+TEST_CASE("posture check: signed distance to a support polygon", "[outer][posture]") {
+  // A 0.2 × 0.1 m rectangle and a second one beside it: the hull of both.
+  const std::vector<Eigen::Vector2d> one = {{-0.1, -0.05}, {0.1, -0.05}, {0.1, 0.05}, {-0.1, 0.05}};
+  CHECK(signedDistanceToHull(one, Eigen::Vector2d(0.0, 0.0)) == Approx(0.05));
+  CHECK(signedDistanceToHull(one, Eigen::Vector2d(0.08, 0.0)) == Approx(0.02));
+  CHECK(signedDistanceToHull(one, Eigen::Vector2d(0.0, 0.15)) == Approx(-0.10));
+  CHECK(signedDistanceToHull(one, Eigen::Vector2d(0.13, 0.09)) == Approx(-0.05));  // from the corner (0.1, 0.05)
+  std::vector<Eigen::Vector2d> two = one;
+  for (const Eigen::Vector2d& c : one) two.push_back(c + Eigen::Vector2d(0.0, 0.2));
+  two.push_back(Eigen::Vector2d(0.0, 0.1));  // inside: not a vertex of the hull
+  CHECK(signedDistanceToHull(two, Eigen::Vector2d(0.0, 0.1)) == Approx(0.1));  // between the two, inside their hull
+  CHECK(signedDistanceToHull(two, Eigen::Vector2d(0.3, 0.1)) == Approx(-0.2));
+  // Two points have no inside.
+  CHECK(signedDistanceToHull({{0.0, 0.0}, {1.0, 0.0}}, Eigen::Vector2d(0.5, 0.0)) == Approx(0.0).margin(1e-15));
+  CHECK(signedDistanceToHull({{0.0, 0.0}, {1.0, 0.0}}, Eigen::Vector2d(0.5, 0.2)) == Approx(-0.2));
 }
 
 }  // namespace mcopt
