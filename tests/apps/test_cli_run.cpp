@@ -1044,3 +1044,25 @@ TEST_CASE("run: a fixed posture the robot cannot hold is reported before the run
   CHECK_THAT(ok.output, Contains("cm inside the support polygon of l_sole, r_sole"));
   CHECK(readJson(dir.path() / "held/result.json")["fixed_postures"][0]["holdable"] == true);
 }
+
+TEST_CASE("run: a posture problem stopped at its iteration cap says so, and the result keeps it", "[cli][run]") {
+  // The kick's configuration optimisation cut to 5 iterations: the posture is not the static
+  // optimum, the run goes on from it and says so, at once and at the end, and result.json keeps it.
+  const test::TempDir dir;
+  const auto scenario = kickVariant(dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["initialisation"]["configuration_iterations"] = 5;
+    root["continuation"] = YAML::Load("[]");
+  });
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 0");
+  INFO(r.all());
+  CHECK(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("start and end posture: maximum_iterations after 5 iterations") && Contains("NOT OPTIMAL"));
+  CHECK_THAT(r.errors, Contains("mcopt: warning: configuration optimisation of the start posture ended maximum_iterations after 5 "
+                                "iterations (its cap, initialisation.configuration_iterations: 5)"));
+  const Json result = readJson(out / "result.json");
+  CHECK(result["configuration_optimisation"]["start"]["status"] == "maximum_iterations");
+  REQUIRE(result["warnings"].size() == 1);
+  CHECK_THAT(result["warnings"][0].get<std::string>(), Contains("not the static optimum"));
+}
