@@ -146,6 +146,8 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                                {"quaternion_xyzw", toJson(quaternionXyzwFromRotation(e.worldPose.rotation))}};
       contact["closure_drift_m"] = r.closureDrift[c - 1];
       contact["closure_drift_rad"] = r.closureRotationDrift[c - 1];
+      contact["closure_speed_m_s"] = r.closureSpeed[c - 1];
+      contact["closure_angular_speed_rad_s"] = r.closureAngularSpeed[c - 1];
     }
     contacts.push_back(contact);
   }

@@ -928,23 +928,28 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
     evaluator.evaluate(x.head(parameterCount_), T, fineResult);
     p.fineTime = fineResult.time, p.finePower = fineResult.power, p.fineEnergy = fineResult.energy;
   }
-  // Closure drift between the samples: the contact frames at the scenario's output samples.
-  const SampledTrajectory fine(parametrization_, scenario_.outputSamples);
-  p.closureDrift.assign(static_cast<std::size_t>(contacts), 0.0);
-  p.closureRotationDrift.assign(static_cast<std::size_t>(contacts), 0.0);
+  // Closure drift between the samples: the contact frames on a fine grid, the scenario's output
+  // samples or 10 instants per sample interval, whichever is finer: how far each frame strays
+  // from its world pose and how fast it slides there.
+  const SampledTrajectory fine(parametrization_, std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1));
+  for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
+    drift->assign(static_cast<std::size_t>(contacts), 0.0);
   for (int s = 0; s < fine.sampleCount(); ++s) {
     const double u = static_cast<double>(s) / (fine.sampleCount() - 1);
     fine.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
-    forwardKinematics(model_, w.data, w.q);
+    inverseDynamics(model_, w.data, w.q, w.v, w.a);  // the poses and the twists
     for (int i = 0; i < contacts; ++i) {
       if (!insideWindow(u, windows_[static_cast<std::size_t>(i)])) continue;
-      const EnvironmentContact& c = scenario_.contacts[static_cast<std::size_t>(i)];
+      const auto k = static_cast<std::size_t>(i);
+      const EnvironmentContact& c = scenario_.contacts[k];
       const RigidTransform pose = framePose(model_, w.data, c.surface.frame) * c.surface.placement;
       const double distance = (pose.translation - c.worldPose.translation).norm();
       const Eigen::AngleAxisd error(Matrix3(c.worldPose.rotation.transpose() * pose.rotation));
-      p.closureDrift[static_cast<std::size_t>(i)] = std::max(p.closureDrift[static_cast<std::size_t>(i)], distance);
-      p.closureRotationDrift[static_cast<std::size_t>(i)] =
-          std::max(p.closureRotationDrift[static_cast<std::size_t>(i)], std::abs(error.angle()));
+      const Vector6 twist = pointTwist(w.data, model_.framePosition(c.surface.frame), pose.translation);
+      p.closureDrift[k] = std::max(p.closureDrift[k], distance);
+      p.closureRotationDrift[k] = std::max(p.closureRotationDrift[k], std::abs(error.angle()));
+      p.closureSpeed[k] = std::max(p.closureSpeed[k], twist.head<3>().norm());
+      p.closureAngularSpeed[k] = std::max(p.closureAngularSpeed[k], twist.tail<3>().norm());
     }
   }
   return p;

@@ -95,8 +95,12 @@ struct SampledPhysics {
   std::vector<std::vector<bool>> active;
   std::vector<Eigen::MatrixXd> centerOfPressure;  ///< 2 × N each
   std::vector<Eigen::VectorXd> frictionMargin;
-  std::vector<double> closureDrift;             ///< per contact: worst distance [m] of its frame from its pose (output samples)
-  std::vector<double> closureRotationDrift;     ///< per contact: worst angle [rad]
+  /// Per environment contact, on a fine grid (the output samples or 10 instants per sample
+  /// interval, the finer) within its window: the worst distance [m] and angle [rad] of its frame
+  /// from its world pose, and the fastest its frame slides [m/s] and turns [rad/s].
+  std::vector<double> closureDrift;
+  std::vector<double> closureRotationDrift;
+  std::vector<double> closureSpeed, closureAngularSpeed;
   std::vector<std::string> innerStatus;         ///< bilevel: per sample
   int infeasibleSamples = 0, failedSamples = 0;
   double energy = 0.0;                          ///< ∫ Σ max(P, 0) dt at the samples (trapezoid)

@@ -803,6 +803,8 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
     REQUIRE(result["contacts"].size() == 2);
     CHECK(result["contacts"][1]["name"] == "r_sole");
     CHECK(result["contacts"][1]["closure_drift_m"].get<double>() >= 0.0);
+    CHECK(result["contacts"][1]["closure_speed_m_s"].get<double>() >= 0.0);
+    CHECK(result["contacts"][1]["closure_angular_speed_rad_s"].get<double>() >= 0.0);
     CHECK(result["contacts"][1]["wrench"].size() == 16);
     CHECK(result["violation_by_kind"].contains("closure"));
     CHECK(result["power_fine"].is_null());
