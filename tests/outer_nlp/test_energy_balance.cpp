@@ -39,8 +39,10 @@ Scenario smaller(const std::string& name, int samples) {
 TEST_CASE("energy balance: the joints' and contacts' work is the change of mechanical energy, on every bundled scenario",
           "[outer][energy]") {
   // Samples chosen so that a throw's release (0.6 T, 0.5 T on the hand-supported one) stays a sample.
+  // At least 10 instants an interval, as results have it: with 2 (tried under the sanitizers)
+  // the hand-supported throw's residual was 1.6e-3 of its scale, Simpson's error at h = 0.12 s.
 #ifdef MCOPT_UNDER_SANITIZERS
-  const int samples = 11, atLeast = 2;
+  const int samples = 11, atLeast = 10;
 #else
   const int samples = 21, atLeast = 10;
 #endif
