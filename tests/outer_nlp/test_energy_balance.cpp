@@ -43,8 +43,10 @@ TEST_CASE("energy balance: the joints' and contacts' work is the change of mecha
   // the hand-supported throw's residual was 1.6e-3 of its scale, Simpson's error at h = 0.12 s.
 #ifdef MCOPT_UNDER_SANITIZERS
   const int samples = 11, atLeast = 10;
+  const double kIdentityTolerance = 1e-5;
 #else
   const int samples = 21, atLeast = 10;
+  const double kIdentityTolerance = 1e-6;
 #endif
   int covered = 0;
   for (const char* name : {"hrp2_kick.yaml", "hrp2_weight_shift.yaml", "hrp2_lean_reach.yaml",
@@ -61,8 +63,9 @@ TEST_CASE("energy balance: the joints' and contacts' work is the change of mecha
               << b.electricalResidual() << " J");
     CHECK(b.instants == perInterval * (samples - 1) + 1 + (scenario.ball ? 1 : 0));
     CHECK(b.mechanicalScale() > 0.1);  // a motion that does something
-    // Simpson's rule on a grid whose pairs do not straddle a knot: far below the 1e-4 asked.
-    CHECK(std::abs(b.mechanicalResidual()) <= 1e-6 * b.mechanicalScale());
+    // Simpson's rule on a grid whose pairs do not straddle a knot: far below the 1e-4 asked
+    // (at 11 samples, under the sanitizers, the hand-supported throw's is 1.6e-6).
+    CHECK(std::abs(b.mechanicalResidual()) <= kIdentityTolerance * b.mechanicalScale());
     // The rotors' ∫ I_m N² q̈ q̇ dt by trapezoids against ΔE_rotor: the same quadrature's error.
     CHECK(std::abs(b.electricalResidual()) <= 1e-4 * std::max({std::abs(b.electricalEnergy), b.jouleLosses, std::abs(b.frictionDissipation), std::abs(b.jointWork)}));
     CHECK(b.positiveEnergy + b.braking == Approx(b.electricalEnergy).epsilon(1e-12).margin(1e-9));
