@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Rehearses the README's two commands as a new user runs them on a fresh Debian 12: a minimal
 # root made by debootstrap (the `minbase` variant: the required packages and apt, nothing of
-# this machine's image), git alone added, this checkout's HEAD cloned into it, then
+# this machine's image), git alone added, this checkout's HEAD cloned into root's home there, then
 # `scripts/run.sh` and `scripts/test.sh` one after the other, each timed. What a step of
 # install-deps.sh misses shows here and nowhere else (issue 48). docs/developers/fresh-debian.md.
 #
 #   scripts/rehearse-fresh-debian.sh [--root DIR] [--shared DIR] [--only run|test] [--keep]
 #
-# --root     where the root is made (default /var/tmp/mcopt-fresh-debian); emptied first
+# --root     where the root is made (default build/fresh-debian in this checkout); emptied first
 # --shared   a shared/ folder put beside the clone, read-only, as CI has it (default: none, as a
 #            newcomer has it)
 # --only     run one of the two commands
@@ -15,7 +15,8 @@
 # The root has /proc, /sys (with no cgroup filesystem: as in a container) and /dev mounted. Its
 # log is DIR.log; the exit status is the first failing command's. Needs root and about 12 GiB.
 set -euo pipefail
-root_dir=/var/tmp/mcopt-fresh-debian
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+root_dir="$source_dir/build/fresh-debian"
 shared=""
 only=""
 keep=0
@@ -30,7 +31,8 @@ while [ $# -gt 0 ]; do
 done
 case "$only" in ""|run|test) ;; *) echo "rehearse: --only takes run or test" >&2; exit 2 ;; esac
 [ "$(id -u)" -eq 0 ] || { echo "rehearse: needs root (debootstrap, chroot, mount)" >&2; exit 2; }
-source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+mkdir -p "$(dirname "$root_dir")"
+root_dir="$(cd "$(dirname "$root_dir")" && pwd)/$(basename "$root_dir")"
 log="$root_dir.log"
 : > "$log"
 say() { echo "rehearse: $*" | tee -a "$log"; }
@@ -66,8 +68,9 @@ cp /etc/resolv.conf "$root_dir/etc/resolv.conf"
 mkdir -p "$root_dir/src"
 mount --bind -o ro "$source_dir" "$root_dir/src"; mounts+=("$root_dir/src")
 if [ -n "$shared" ]; then
-  mkdir -p "$root_dir/work/shared"
-  mount --bind -o ro "$shared" "$root_dir/work/shared"; mounts+=("$root_dir/work/shared")
+  # Beside the clone in root's home, as CI has shared/ beside its clone.
+  mkdir -p "$root_dir/root/shared"
+  mount --bind -o ro "$shared" "$root_dir/root/shared"; mounts+=("$root_dir/root/shared")
 fi
 
 # A clean environment, as a login shell of a new machine has it.
@@ -85,13 +88,13 @@ timed() {  # name, command...
 }
 
 timed "git" "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends git ca-certificates"
-timed "clone" "git clone -q /src /work/mcopt && git -C /work/mcopt log -1 --format='%h %s'"
+timed "clone" "git clone -q /src ~/mcopt && git -C ~/mcopt log -1 --format='%h %s'"
 status=0
 if [ -z "$only" ] || [ "$only" = run ]; then
-  timed "scripts/run.sh" "cd /work/mcopt && scripts/run.sh" || status=$?
+  timed "scripts/run.sh" "cd ~/mcopt && scripts/run.sh" || status=$?
 fi
 if [ $status -eq 0 ] && { [ -z "$only" ] || [ "$only" = test ]; }; then
-  timed "scripts/test.sh" "cd /work/mcopt && CI=true scripts/test.sh" || status=$?
+  timed "scripts/test.sh" "cd ~/mcopt && CI=true scripts/test.sh" || status=$?
 fi
 say "total $((SECONDS - start)) s; log $log"
 exit $status
