@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The subcommands of `mcopt`; each registers its options on the CLI11 app and returns
 // the function that runs it (exit code).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt dynamics`: inverse dynamics of given states with the reference body held
 // fixed (formulation.md §4), and with --contacts the torques that given contact wrenches
 // leave to the motors (§5). Formats: docs/file-formats.md.

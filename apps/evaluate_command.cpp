@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt evaluate`: the main job until the optimiser lands (issue 2). Reads a motion
 // file (docs/file-formats.md), evaluates torques, reference-body wrench and electrical
 // energy at every sample, prints a summary and optionally writes results atomically.

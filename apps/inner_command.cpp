@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt inner`: solve inner contact-force problems given as data (formulation.md §7), one
 // per time sample, with a chosen solver and contact model. Formats: docs/inner-problem.md.
 #include <iostream>

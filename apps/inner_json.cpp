@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "apps/inner_json.hpp"
 
 #include "sensitivity/inner_sensitivity.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt: whole-body motion optimisation for humanoid robots in multi-contact.
 #include <iostream>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt plot RESULT_DIR [--out DIR]`: figures of one optimised motion, PNG and SVG, drawn by
 // scripts/plot_result.py with matplotlib (docs/plots.md).
 #include <filesystem>

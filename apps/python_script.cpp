@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "apps/python_script.hpp"
 
 #include <sys/wait.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The figures are drawn by Python scripts with matplotlib (scripts/plot_*.py), run as child
 // processes: `mcopt plot` and `mcopt study collect`; `mcopt report` measures with one.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The scene of a replay (docs/replay.md): what the page draws at each sample of a result —
 // every body's world pose, every contact's frame, wrench and centre of pressure in world

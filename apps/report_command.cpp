@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt report [--quick] [--out DIR] [--time-limit S] [--docs FILE]`: the report's figures and
 // tables measured on this machine, beside the report's own (docs/benchmarks.md). The
 // measuring is scripts/report.py's: per-evaluation times from mcopt-bench, whole

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt robot info`: what a robot description contains, in text or JSON.
 #include <iomanip>
 #include <iostream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "apps/robot_info_json.hpp"
 
 #include "core/inverse_dynamics.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A robot description as JSON (`mcopt robot info --json`, and `Robot.info()` in Python):
 // name, source, mass, centre of mass at the zero posture, joints with their limits and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "apps/robot_visuals.hpp"
 
 #include <urdf_parser/urdf_parser.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What a robot looks like, body by body, for drawing it (mcopt replay, docs/replay.md): the
 // URDF's visual primitives, or where a link has none, primitives made from its mass

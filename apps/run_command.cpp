@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt run`: the project's main job (issue 7). Reads a scenario (docs/scenarios.md),
 // optionally optimises the static start and end postures (report §3.5), then optimises the
 // whole motion with Ipopt (formulation.md §10), printing a line per iteration, and writes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "apps/run_output.hpp"
 
 #include <iomanip>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What a scenario's run leaves (docs/scenarios.md, "Results"): result.json, trajectory.csv,
 // power_fine.csv, states.json (the sampled states as a `mcopt dynamics` input) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt study`: sweeps of scenarios run as studies (docs/studies.md).
 //   mcopt study SWEEP.yaml [--jobs N | --slurm [--wait]] [--out DIR]   prepare, then run the unfinished cases
 //   mcopt study collect DIR [--no-plots]                                 cases.csv and summary plots

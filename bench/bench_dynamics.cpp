@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // InverseDynamics/PerSample/<robot> and InverseDynamics/Trajectory100/<robot>.
 #include <benchmark/benchmark.h>
 

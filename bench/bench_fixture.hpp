@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Shared set-up for mcopt-bench: the robots (ours and, when present, ../shared's),
 // seeded inputs, and the context printed with the numbers.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Inner/<solver>/<contact-model>/<contacts>: one inner solve, cycling through the 100
 // samples of an HRP-2 motion in order (each warm-started from the previous sample, as in
 // use; "active-set-cold" without). BilevelDynamics/<n>Contacts100/hrp2[/slsqp|/ipopt]: the report's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt-bench: every benchmark is named Module/Case/robot so a run can be filtered
 // (--benchmark_filter=InverseDynamics/PerSample). Machine, build type and commit are
 // printed with the numbers. Threads for the trajectory cases: OMP_NUM_THREADS.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Optimisation/<scenario>/<formulation>[/<inner solver>]: Ipopt on a bundled scenario's motion
 // problem (formulation.md §9, §10), from the scenario's initial motion, for a fixed number of
 // iterations (counter `max_iter`; the multi-contact scenarios do not converge yet, docs/

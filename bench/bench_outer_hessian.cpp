@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // OuterHessian/Kick100/hrp2/<option>: one evaluation of the Lagrangian's Hessian of the
 // bundled kick's motion problem (100 samples, 150 spline parameters) at its initial motion,
 // with unit multipliers, for each `hessian:` option that evaluates one (docs/scenarios.md,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // BilevelGradient/<n>Contacts100/hrp2/<backend>: the report's Figure 5.2 "gradient" of a
 // multi-contact motion — energy and every sampled torque (and contact wrench) w.r.t. all
 // 150 motion parameters and T, N = 100 — through the inner KKT sensitivity factorised per

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The HRP-2 motion of the multi-contact benchmarks (Inner/*, BilevelDynamics/*, BilevelGradient/*).
 #include <filesystem>

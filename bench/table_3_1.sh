@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # The report's Table 3.1 experiment on the kick with the report's free ends (scenarios/hrp2_kick_free_ends.yaml;
 # docs/scenarios.md, "Table 3.1"):
 # the same motion optimisation with and without configuration optimisation, reporting the

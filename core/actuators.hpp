@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Actuator side file and the electrical power model (formulation.md §2, §4, §6).
 //

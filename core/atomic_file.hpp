@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Results are written atomically: to a temporary file beside the target, flushed,
 // then renamed over it, so an interrupted run never leaves a half-written file.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Clamped uniform cubic B-splines for joint trajectories (formulation.md §3).
 //   q_j(t) = Σ_k p_jk b_k(t/T),  t ∈ [0, T],  n control points (default 9, 6 spans).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/contact_maps.hpp"
 
 #include "core/kinematics.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The wrench maps of formulation.md §5 for one contact frame C on the robot, and their
 // derivatives with respect to q. A contact wrench F = (f, m) is what the environment

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // DynamicsData: every per-sample buffer of the Newton–Euler recursion, sized once
 // from a DynamicsModel (style.md: Model / Data). Hot functions write into it and

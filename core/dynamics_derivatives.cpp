@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/dynamics_derivatives.hpp"
 
 #include "core/hot_path_checks.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Exact analytic derivatives of the rooted Newton–Euler inverse dynamics (issue 4,
 // formulation.md §4): ∂Γ0/∂(q, q̇, q̈) and ∂W0/∂(q, q̇, q̈).

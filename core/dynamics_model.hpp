@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // DynamicsModel: the robot's tree re-rooted at the reference body, which is held
 // fixed at a known world pose (formulation.md §2, report §3.2). Immutable; the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Bad input and misuse throw InputError with a message that names the file,
 // line or field and what was expected (style.md, "two kinds of failure").

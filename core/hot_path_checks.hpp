@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Sizes on the per-sample hot path (dynamics, derivatives, kinematics) are debug assertions:
 // a check there would cost a noticeable share of a small robot's Newton–Euler pass, and every

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/inverse_dynamics.hpp"
 
 #include "core/hot_path_checks.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Recursive Newton–Euler inverse dynamics in the world frame, rooted at the
 // reference body (formulation.md §4). One call is O(number of bodies) and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Kinematic quantities read from a DynamicsData filled by forwardKinematics or
 // inverseDynamics (formulation.md §4–§5). No allocation when outputs are pre-sized.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/motion_derivatives.hpp"
 
 #include "core/spatial_algebra.hpp"

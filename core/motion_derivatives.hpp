@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Derivatives of a body's spatial twist V and acceleration A (world frame, at the world
 // origin; A includes the fictitious −g of the reference body) with respect to q, q̇, q̈

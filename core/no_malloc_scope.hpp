@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The debug preset's MCOPT_CHECK_MALLOC (CMakeLists.txt, CMakePresets.json): Eigen's run-time
 // no-malloc check (EIGEN_RUNTIME_NO_MALLOC), armed around a per-sample path once its buffers

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What a path names, without throwing: std::filesystem::exists and is_regular_file throw
 // filesystem_error on a name the system refuses (too long: found by fuzzing,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/robot_files.hpp"
 
 #include "core/yaml_fields.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // RobotModel: the robot as its URDF describes it, with fixed joints merged
 // (formulation.md §1–§2). Immutable once loaded; the dynamics work on a

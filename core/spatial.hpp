@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Rigid transforms and rotation helpers shared by the whole project.
 // Rotations are matrices internally (formulation.md §1); files use quaternions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // 6-D spatial algebra at the world origin (formulation.md §4): motion vectors (v_O, ω),
 // force vectors (f, n_O), both linear part first.

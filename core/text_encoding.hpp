@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Text read from robot files reaches result.json and the viewer as names (robot, links, joints),
 // and JSON must be UTF-8: a name with a stray byte made the JSON writer throw after the run

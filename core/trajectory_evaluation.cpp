@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "core/trajectory_evaluation.hpp"
 
 #include <omp.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A whole motion: splines → (q, q̇, q̈) → Newton–Euler → motor power → energy at
 // every sample (formulation.md §3–§6). Samples are independent and run in parallel

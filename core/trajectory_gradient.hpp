@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Exact gradients of a whole motion with respect to its free spline parameters x and the
 // duration T (issue 4): every sampled torque and the energy. Sample s depends on at most

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Reading YAML with messages that name the file, the line and the field (yaml-cpp marks).
 // For the loaders' .cpp files: the one core header with yaml-cpp types, which core links

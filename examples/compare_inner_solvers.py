@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Compare the three inner contact-force solvers over a motion (docs/python.md).
 
 The motion is a bundled two-contact scenario (by default the weight shift: both soles on the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The in-house inner solver (formulation.md §7): an SQP loop over the friction cones with
 // a dual active-set QP (dual_active_set_qp.hpp) inside, warm-started from the previous
 // sample's result, allocation-free once it has seen a problem of the same size.

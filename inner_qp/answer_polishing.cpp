@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/answer_polishing.hpp"
 
 #include <Eigen/QR>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Polishing the third-party solvers' answers (docs/inner-problem.md, "Polishing"; private
 // header): each answer of SLSQP or Ipopt on a linear contact model solved again exactly, by

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/contact_problem.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The inner problem of one time sample (formulation.md §5, §7): the contact wrenches
 // Fc = (F_1 … F_nc), each F_i = (f, m) in its own contact frame C_i, that minimise the

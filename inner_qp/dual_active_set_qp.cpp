@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/dual_active_set_qp.hpp"
 
 #include <Eigen/Cholesky>

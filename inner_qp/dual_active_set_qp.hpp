@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A dense, strictly convex QP solved by the dual active-set method of Goldfarb and Idnani
 // (Math. Programming 27, 1983), the core of the in-house inner solver (formulation.md §7):

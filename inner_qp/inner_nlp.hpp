@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The inner problem as a plain NLP, shared by the third-party adapters (private header).
 // Variables x = Fc (6nc). Constraints, in order:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/inner_solver.hpp"
 
 #include <Eigen/QR>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // One interface for the inner-problem solvers (formulation.md §7, style.md §7: settings,
 // result, status). Every solver fills the same InnerResult; numerical outcomes are

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Ipopt on the inner problem: the report's slow baseline (formulation.md §7). Ipopt's
 // headers stay in this file. Exact Hessian of the Lagrangian: H plus, per cone, its
 // multiplier times the cone constraint's Hessian (InnerNlp::coneHessian).

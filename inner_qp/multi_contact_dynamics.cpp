@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/multi_contact_dynamics.hpp"
 
 #include <omp.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The multi-contact "dynamic model" of the report's Figure 5.2: a whole motion, splines →
 // (q, q̇, q̈) → Newton–Euler at the fixed reference body (Γ0, W0) → at every sample the inner

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // NLopt SLSQP on the inner problem (formulation.md §7). NLopt's headers stay in this file.
 // NLopt returns no multipliers: they are estimated by least squares on the active set, and
 // a stop on an x/f tolerance is re-checked against the constraints by the common flow.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/ballistic_flight.hpp"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The ball's flight after release (formulation.md §10, "throw to target"): from the release
 // position p and velocity v under gravity g (along −z), p(τ) = p + v τ + ½ g τ². The flight

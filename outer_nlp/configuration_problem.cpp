@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/configuration_problem.hpp"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Configuration optimisation (report §3.5, formulation.md §10): a static posture q for the
 // start or the end of the motion that minimises the static electrical power under the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A contact's admissibility as rows ≥ 0 on its wrench (formulation.md §5, §10), for the
 // formulations whose wrenches the outer NLP holds itself: the reference contact's W0 whenever

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/contact_force_parametrization.hpp"
 
 #include <Eigen/QR>

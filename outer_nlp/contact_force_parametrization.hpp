@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The wrenches of the non-reference contacts as linear functions of NLP variables z, for the
 // single-level formulations (formulation.md §9, methods 2 and 3):

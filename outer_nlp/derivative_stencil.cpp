@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Derivative stencils exact on polynomials and trigonometric polynomials of a given degree
 // (derivative_stencil.hpp). Both are antisymmetric, d_{−m} = −d_m: the even part of f
 // contributes nothing, and the weights solve the K × K system for the odd basis functions.

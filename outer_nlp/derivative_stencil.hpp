@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Derivative stencils that are exact — up to rounding, not up to a truncation error — on the
 // functions the `exact` Hessian option differentiates (outer_nlp/motion_hessian.cpp;

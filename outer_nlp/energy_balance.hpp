@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Where a motion's energy goes (docs/scenarios.md, "Energy balance"), on a fine grid of the
 // motion: the joints' net mechanical work, the change of the robot's potential and kinetic

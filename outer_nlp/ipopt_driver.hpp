@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Solves an NlpProblem with Ipopt (formulation.md §10): exact first derivatives, the
 // declared sparse Jacobian, a limited-memory Hessian unless the options say otherwise,

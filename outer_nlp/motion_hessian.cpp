@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The Lagrangian's Hessian of the motion problem by per-sample differences (formulation.md
 // §10; docs/scenarios.md, "Hessian and convergence").
 //

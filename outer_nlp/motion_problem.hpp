@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The outer motion problem of one scenario as a plain NLP (formulation.md §10), independent
 // of Ipopt so that tests can probe it: variables, bounds, objective, constraints, their

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A scenario's whole motion solve (docs/scenarios.md, "Continuation" and "Torque-limit
 // screening"): its continuation stages, each from the previous one's iterate, then its own

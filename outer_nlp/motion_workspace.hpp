@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // MotionProblem's per-thread evaluation buffers, shared by its evaluation
 // (motion_problem.cpp) and its Hessian (motion_hessian.cpp); not part of the interface.

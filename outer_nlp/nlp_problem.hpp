@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A smooth NLP with exact first derivatives and a sparse constraint Jacobian whose pattern
 // is fixed once: min f(x) s.t. x_L ≤ x ≤ x_U, g_L ≤ g(x) ≤ g_U. The motion problem and the

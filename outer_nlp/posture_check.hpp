@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Whether the robot can hold the scenario's fixed postures at rest (docs/scenarios.md, "Fixed
 // postures the robot cannot hold"), checked before the optimisation: a fixed start or end

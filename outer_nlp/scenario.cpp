@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/scenario_yaml.hpp"
 
 #include <algorithm>

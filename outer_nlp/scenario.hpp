@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A motion-optimisation scenario (docs/scenarios.md): the robot and its side files, the
 // reference body, the contacts, the duration and samples, the objective, the limits, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A scenario's whole run (docs/scenarios.md): the optional configuration optimisation of its
 // end postures (report §3.5), then the motion solve with its continuation stages and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A scenario already parsed as YAML (a study's case after its fields are changed,
 // docs/studies.md; the Python module's Scenario). outer_nlp links yaml-cpp privately: this is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The smooth maximum P⁺ ≈ (P + sqrt(P² + ε²)) / 2 of the energy criterion its slope and its curvature
 // (formulation.md §6): one definition for the objective, its gradient and its Hessian.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The quantities a task bounds (formulation.md §10) and their exact derivatives with
 // respect to q and q̇, read from a DynamicsData filled by inverseDynamics at (q, q̇, q̈):

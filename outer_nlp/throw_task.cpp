@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The `throw` task of a scenario file, read into the ball and its two rows (declared in
 // outer_nlp/scenario_yaml.hpp, outer_nlp's one header with yaml-cpp types).
 #include <array>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // The Python module `mcopt` (docs/python.md): one bind function per family, and the
 // conversions they share. Values cross as numpy arrays (float64, C order) and dicts; every

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt.Dynamics: inverse dynamics with the reference body held fixed (formulation.md §4),
 // the reference wrench, and their exact derivatives; what `mcopt dynamics` computes.
 #include <pybind11/stl.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What a mcopt.Dynamics holds: the robot re-rooted at its reference body (formulation.md
 // §4), with the per-call workspace. A Dynamics is used under the GIL, one call at a time.

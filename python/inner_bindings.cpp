@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt.InnerProblem, mcopt.InnerSolver, mcopt.InnerResult: the inner contact-force problem
 // of one time sample (formulation.md §7) and its sensitivity (§8), what `mcopt inner` solves.
 // A problem given as arrays goes through the reader of `mcopt inner`'s JSON problems, so it

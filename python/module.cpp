@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The Python module `mcopt` (docs/python.md): robot models, dynamics and their derivatives,
 // the inner contact-force problem with its solvers and sensitivity, and scenarios run with
 // a progress callback. The command line's readers and writers are shared (apps/), so the

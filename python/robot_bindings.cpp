@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt.Robot: a URDF with its side files (formulation.md §2, docs/robot-files.md).
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>

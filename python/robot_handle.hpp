@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What a mcopt.Robot holds: the model, shared with every Dynamics built on it, its actuators
 // and its contact surfaces.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // mcopt.Scenario: a scenario file (docs/scenarios.md) whose fields can be read and changed by
 // field path (the sweep's paths, docs/studies.md), and run like `mcopt run` with a progress
 // callback, the GIL released while it runs and Ctrl-C ending it with its last iterate.

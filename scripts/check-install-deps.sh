@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Checks that scripts/install-deps.sh provides every program and Python module that the build,
 # the test suite and the scripts call: each one must be installed and come from a package that
 # install-deps.sh installs, or from one of their dependencies, or from a package every Debian

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Builds the libFuzzer targets (the `fuzz` preset: clang, ASan, UBSan) and runs each for
 # SECONDS (default 60) from its seed corpus in tests/fuzz/corpus/<target>/ plus the inputs it
 # found before (build/fuzz/corpus/<target>/), after replaying every regression input of

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Fair baselines for the inner contact-force solvers (issue 19, docs/inner-problem.md).
 
 Random feasible inner problems of the report contact model (formulation.md §7) are each

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs mcopt's build dependencies from Debian 12 packages. Idempotent:
 # packages already present are skipped, so it is cheap to run before every build.
 # `install-deps.sh --list` prints the packages, one a line, and installs nothing

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Figures of one optimised motion (docs/plots.md), from the result folder `mcopt run` wrote:
 joint positions and torques within their limits, contact wrenches and friction-cone margins,
 centres of pressure inside their rectangles, power per joint and cumulative energy,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Rehearses the README's two commands as a new user runs them on a fresh Debian 12: a minimal
 # root made by debootstrap (the `minbase` variant: the required packages and apt, nothing of
 # this machine's image), git alone added, this checkout's HEAD cloned into root's home there, then

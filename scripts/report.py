@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """The measurements behind `mcopt report` (docs/benchmarks.md): the analogues of the report's
 Figure 5.1 (one-contact dynamic model and gradient), Figure 5.2 (multi-contact dynamic model,
 gradient and whole optimisation for each contact-force formulation and inner solver), Table

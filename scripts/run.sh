@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs the dependencies, builds mcopt (Release) and runs the main job on the
 # bundled HRP-2 scenario. Extra arguments go to `mcopt`, e.g. `scripts/run.sh run X.yaml`.
 set -euo pipefail

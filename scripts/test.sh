@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs the dependencies, then builds and runs the whole test suite twice:
 # Release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer.
 # Then each libFuzzer target briefly (scripts/fuzz.sh, docs/fuzzing.md): MCOPT_FUZZ_SECONDS a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "sensitivity/bilevel_sample.hpp"
 
 #include "core/errors.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // One time sample of the bilevel formulation (formulation.md §7–§9, the report's Figure
 // 4.3): the inner problem over the contacts active at this sample picks the wrenches F*,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Sensitivity of an inner solution (formulation.md §8; the report's (4.25)–(4.47)): at the
 // optimal wrenches F with strictly active set A, the KKT conditions

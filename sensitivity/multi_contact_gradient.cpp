@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "sensitivity/multi_contact_gradient.hpp"
 
 #include <omp.h>

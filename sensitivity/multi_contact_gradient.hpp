@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Exact gradients of a multi-contact motion (the report's Figure 5.2 "gradient", formulation.md
 // §8): for every sample the inner problem is solved, its KKT system factorised once, and the

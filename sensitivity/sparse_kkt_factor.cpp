@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "sensitivity/sparse_kkt_factor.hpp"
 
 #include <klu.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A SuiteSparse LU of one sample's KKT system (formulation.md §8), through KLU's and
 // UMFPACK's own interfaces. Analyse once, factorise many (style.md §10): the symbolic

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Starting and waiting for child processes, for the study's case runner, local pool and Slurm
 // submission (POSIX fork/exec: each optimisation runs in a process of its own, because Ipopt

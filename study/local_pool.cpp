@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "study/local_pool.hpp"
 
 #include <sys/wait.h>

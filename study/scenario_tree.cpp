@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "study/scenario_tree.hpp"
 
 #include "outer_nlp/scenario.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A scenario's YAML tree to be written away from its file (a study's case, a scenario saved
 // from Python): its side files (kScenarioSideFileFields) are relative to the scenario file, so

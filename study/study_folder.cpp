@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #include "study/study_folder.hpp"
 
 #include <nlohmann/json.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A study's folder (docs/studies.md, "The study folder"): study.json (the design and the
 // resources), one folder per case with its scenario, the result folder of `mcopt run`, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A sweep (docs/studies.md): a base scenario, fields set for every case, and fields varied by a
 // design — a grid of listed values, or a seeded random or Latin-hypercube design over lists and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 cmake_minimum_required(VERSION 3.20)
 # Third-party libraries stay behind the targets that link them privately (style.md §9,
 # issue 19): no public header of core, inner_qp, sensitivity or outer_nlp names yaml-cpp,

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: BSD-3-Clause
 """Writes hrp2.urdf and the parameter table of README.md from the one table below.
 
 Every number carries its source or estimation method (column `source`). Published facts

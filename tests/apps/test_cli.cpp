@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The `mcopt` command as a user meets it: outputs, formats, messages and exit codes.
 #include <catch2/catch.hpp>
 #include <fstream>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Determinism (issue 19, docs/scenarios.md "Determinism"): the same input gives the same
 // output, to the bit, with 1 and 2 OpenMP threads and from run to run — every number of
 // result.json but the clocks', and every side file byte for byte.

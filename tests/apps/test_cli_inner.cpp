@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt inner` as a user meets it: the JSON problems of docs/inner-problem.md in, one
 // result per problem out, the same answers as the library, clear errors for bad input.
 #include <catch2/catch.hpp>

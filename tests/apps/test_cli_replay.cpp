@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt replay` (issue 16, docs/replay.md): the page's scene against the result it is drawn
 // from — every body at every sample, the contact force in world axes equal to the wrench the
 // environment applies (W0 with one contact) — and results it cannot draw refused. The page in

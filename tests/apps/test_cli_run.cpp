@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt run` as a user meets it (issue 7, docs/scenarios.md): Ipopt's derivative checker on
 // the bundled scenario, the result files, torques reproduced by `mcopt dynamics`, an
 // interrupted run, a killed run's checkpoint, and a message naming file, line and field for every class of bad input.

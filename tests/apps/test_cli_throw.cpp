@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt run` on a throw (issue 15, docs/scenarios.md "Throw"): the bundled throw ends optimal
 // and its ball, computed here from the result's own q and q̇ at the release by forward
 // kinematics (not the optimiser's rows), lands within 1 mm of the target, and `mcopt plot`

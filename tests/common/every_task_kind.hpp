@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // One task of every kind a scenario may state (but the throw's), on the HRP-2 kick's robot,
 // with bounds on some components and windows and instants inside its 1.6 s: for tests of

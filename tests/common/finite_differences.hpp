@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Central differences for the derivative tests (style.md §4): each entry of x is perturbed
 // by ±h in place, f() re-evaluated, and the entry restored to its exact original value.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A JSON file as nlohmann::json (results, problems, reports the CLI tests read back).
 #include <filesystem>

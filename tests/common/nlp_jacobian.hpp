@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // An NlpProblem's sparse Jacobian as a dense matrix, its declared pattern, and its exact
 // derivatives' errors against central differences, for the derivative tests of the outer problems.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A motion problem's initial point with its spline parameters (± size) and force variables
 // (± 20 size, newtons) perturbed at random: a generic point for the outer problems' tests.

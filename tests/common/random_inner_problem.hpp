@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Random inner problems (formulation.md §7) shared by the solver and command tests: nc
 // contacts — a floor foot, then feet, a hand on a wall, a hand on a table — with a balance

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Loading the test robots: ours (always) and the third-party ones of ../shared.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Runs the built `mcopt` executable and captures its output and exit code.
 #include <sys/wait.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A bundled scenario changed for a test: its side files named absolutely (so that the copy
 // may live anywhere), then `edit` applied, written into the test's folder.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A temporary folder removed at the end of the test.
 #include <cstdlib>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Shared helpers for the test suite: data locations, seeded random states,
 // relative-error comparisons.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Every bad-input case of the robot files gets an InputError naming the file and the
 // element or field (issue 2 acceptance).
 #include <catch2/catch.hpp>

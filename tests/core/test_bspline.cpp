@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Clamped cubic B-splines (formulation.md §3): basis properties, derivatives against
 // central differences, rest at both ends, continuous limits through control points,
 // local parameter weights.

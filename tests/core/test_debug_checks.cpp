@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Debug builds only: sizes on the per-sample hot path are assertions (core/hot_path_checks.hpp);
 // a wrong size aborts with a message naming the function, instead of reading past a buffer.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The fact the `exact` Hessian option rests on (outer_nlp/motion_hessian.cpp,
 // outer_nlp/derivative_stencil.hpp): in the world frame rooted at the reference body, the
 // joint torques Γ0 and the reference wrench W0 — and with them their first derivatives — are

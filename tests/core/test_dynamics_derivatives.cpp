@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Analytic derivatives of Γ0 and W0 against central finite differences (issue 4
 // acceptance: relative error ≤ 1e-6 scaled by 1 + |value|) on random states of every robot,
 // rooted at a sole so that reversed joints are exercised.

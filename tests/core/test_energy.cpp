@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Electrical power and energy (formulation.md §6).
 #include <catch2/catch.hpp>
 #include <numbers>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The per-sample paths allocate nothing (style.md: "no allocation is enforced, not hoped
 // for"). Every heap allocation is counted, not only `new`: malloc, calloc, realloc and the
 // aligned allocators are interposed (glibc: an executable's definitions take precedence for

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Debug builds (MCOPT_CHECK_MALLOC) only: every per-sample path arms Eigen's no-malloc check
 // once warm (core/no_malloc_scope.hpp), and an allocation introduced on a guarded path stops
 // the program. What the allocation counter (test_no_allocation.cpp) proves in every build,

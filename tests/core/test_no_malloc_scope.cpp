@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The debug preset's MCOPT_CHECK_MALLOC arms Eigen's no-malloc check (core/no_malloc_scope.hpp):
 // compiled only in builds with MCOPT_CHECK_MALLOC (tests/CMakeLists.txt), where it can fail.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Derivatives through the splines and the energy model against central differences
 // (issue 4 acceptance), plus the wrench maps of formulation.md §5 and body motion.
 #include <catch2/catch.hpp>

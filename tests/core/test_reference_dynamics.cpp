@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Inverse dynamics against the independent Pinocchio values of ../shared/reference
 // (issue 2 acceptance): torques and reference wrench within 1e-8·(1 + |value|).
 #include <catch2/catch.hpp>

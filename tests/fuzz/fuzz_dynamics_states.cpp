@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // `mcopt dynamics --states` input (docs/file-formats.md) on HRP-2, with derivatives: the
 // command's own reader and the dynamics it runs.
 #include "tests/fuzz/fuzz_support.hpp"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Scenario YAML as `mcopt run` reads it (docs/scenarios.md): the loader with its side files,
 // then the motion problem built from it, up to where Ipopt would start.
 #include "core/errors.hpp"

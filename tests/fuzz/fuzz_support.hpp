@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // What the fuzz targets share (docs/fuzzing.md): each input is written where the command line
 // would read it, and read through the command's own code. A bad input may end in InputError —

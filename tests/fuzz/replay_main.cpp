@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Runs one fuzz target's LLVMFuzzerTestOneInput on files, without libFuzzer: the seed corpus
 // and every regression input (a crash, hang or sanitizer report found once) in the ordinary
 // test suite, under whatever compiler and sanitizers it is built with (docs/fuzzing.md).

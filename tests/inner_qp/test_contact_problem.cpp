@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Assembly of the per-sample inner problem (formulation.md §5, §7): objective, balance and
 // the three contact models' constraints, checked on hand-built wrenches.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The inner problem as the NLP solvers see it (inner_qp/inner_nlp.hpp): every value the
 // callbacks report is written, and agrees with the Jacobian they report, in each balance mode.
 // The elastic phase 2's band rows once had a Jacobian and no values, so SLSQP and Ipopt read

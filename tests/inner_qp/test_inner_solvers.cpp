@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // One catalogue of random inner problems through every solver (style.md §6): same optimum
 // of the report model, feasible, KKT-certified; the pyramid's convergence to the cone; the
 // wrench cone inside the report model; infeasible samples; warm starts.

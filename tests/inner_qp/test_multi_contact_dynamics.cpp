@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The multi-contact dynamic model (splines → Newton–Euler → inner solve per sample) checked
 // by physics that needs no reference: one contact reduces to the one-contact evaluator; the
 // chosen wrenches balance the robot; the joint torques do not depend on which foot is the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The single-level formulations' contact rows (outer_nlp/contact_admissibility.hpp): the
 // scenario's contact model on each wrench, the same rows as the inner problem's
 // (inner_qp/contact_problem.hpp), with exact derivatives; the wrench cone's yaw rows present

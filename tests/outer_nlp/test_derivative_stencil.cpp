@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The exact Hessian's stencils (outer_nlp/derivative_stencil.hpp): exact, to rounding, on
 // every polynomial / trigonometric polynomial of their degree (a line for the one-sided
 // stencil), at any point and step — and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The energy balance (outer_nlp/energy_balance.hpp; docs/scenarios.md, "Energy balance"):
 // the joints' net work plus the environment contacts' work equals the change of the robot's
 // mechanical energy (and a thrown ball's), on every bundled scenario's problem, at motions

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The Ipopt driver on problems with known solutions: both Hessian modes reach them, the
 // finite-difference Hessian in Newton-like iteration counts, a stop request is honoured and
 // bad options are refused with the scenario's line.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The motion problem's Lagrangian Hessian by per-sample differences (outer_nlp/motion_hessian.cpp)
 // against central differences of the exact whole gradient ∇L = σ ∇f + Jᵀ λ, and against the
 // generic differences of whole gradients: the kick (every task kind it has, the acceleration

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The outer problem's exact derivatives (formulation.md §10) against central differences:
 // objective gradient and every declared Jacobian entry, for both energy forms, fixed and
 // free duration, on the bundled kick; the declared pattern holds every non-zero; the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The multi-contact outer problem (formulation.md §9, §10): every contact-force formulation's
 // exact gradient and Jacobian against central differences — two and three contacts, a
 // contact window that starts and ends inside the motion, an unloaded contact, infeasible

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The throw (formulation.md §10, issue 15): the ballistic flight's exact gradients and Hessians, the
 // throw rows and the carried ball through the whole outer problem against central
 // differences (fixed and free duration, so fixed and free release time; double and single

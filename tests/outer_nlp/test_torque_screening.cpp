@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Torque-limit screening (docs/scenarios.md, "Torque-limit screening"): the motion problem
 // with some torque-limit rows left out is the full problem minus exactly those rows — same
 // objective and gradient, every remaining row with the same value, bounds and Jacobian —, and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Shared helpers of the Python module's tests (docs/python.md).
 
 CTest runs these with the build tree's module on PYTHONPATH and MCOPT_EXECUTABLE naming the

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 # Installs the python component into a fresh prefix and imports the module from there alone
 # (run by CTest: cmake -DBUILD_DIR= -DPREFIX= -DPYTHON= -DMODULE_DIR= -DSOURCE_DIR= -P this).
 file(REMOVE_RECURSE "${PREFIX}")

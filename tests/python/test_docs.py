@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The README's and docs' commands name paths that exist (issue 19: "the README's commands and
 paths are the ones that work"): every build/release/... path is checked in this build tree,
 every scripts/, scenarios/, robots/, docs/ path and every relative Markdown link in the

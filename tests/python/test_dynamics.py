@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """mcopt.Dynamics against `mcopt dynamics [--derivatives]` (to 1e-12), batches against single
 states, and refusals of wrong shapes and types."""
 import json

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """The example of docs/python.md runs as a user would run it, and says what it should."""
 import pathlib
 import re

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """mcopt.InnerProblem / InnerSolver / InnerResult against `mcopt inner [--sensitivity]`: the
 same problems (built from robot states along a motion), each solver and contact model, warm
 starts along the list as the CLI does, results and sensitivities equal to 1e-12."""

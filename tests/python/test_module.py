@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """Every class, method and property of the module says what it is (docs/python.md)."""
 import inspect
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """`mcopt report --quick` (docs/benchmarks.md): the structure of report.json and report.md,
 the report's own figures beside ours, the generated block of a docs file replaced and nothing
 else, and a whole optimisation stopped at the time limit with its last iterate."""

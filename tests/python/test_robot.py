@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """mcopt.Robot against `mcopt robot info --json`, and its refusals against the CLI's."""
 import numpy as np
 import pytest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: BSD-3-Clause
 """mcopt.Scenario: fields by path, validation with the loader's messages, a run equal to
 `mcopt run` (result.json to 1e-12), progress, stop, Ctrl-C and the GIL released."""
 import json

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Our HRP-2 model against the published facts (issue 3 acceptance): 30 joints, 58 kg,
 // 1.54 m at the zero posture, and half-sitting statics on either sole.
 #include <catch2/catch.hpp>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // Derivatives of the inner solution from its KKT system (formulation.md §8), checked
 // against central differences of the re-solved problem and against the envelope theorem.
 #include <catch2/catch.hpp>

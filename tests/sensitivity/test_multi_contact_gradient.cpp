@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: BSD-3-Clause
 // The multi-contact gradient (formulation.md §8, (4.8)): sampled torques, contact wrenches and
 // the energy differentiated w.r.t. the spline parameters and the duration, against central
 // differences of the multi-contact dynamic model itself.
