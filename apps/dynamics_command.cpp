@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt dynamics`: inverse dynamics of given states with the reference body held
 // fixed (formulation.md §4), and with --contacts the torques that given contact wrenches
-// leave to the motors (§5). Formats: docs/file-formats.md.
+// leave to the motors (§5). Formats: docs/reference/input-files.md.
 #include <algorithm>
 #include <iostream>
 #include <optional>
@@ -38,7 +38,7 @@ RigidTransform readPose(const std::filesystem::path& file, const json_io::Json& 
   return pose;
 }
 
-/// Contact wrenches per state (docs/file-formats.md, "Contact wrenches"): each listed surface
+/// Contact wrenches per state (docs/reference/input-files.md, "Contact wrenches"): each listed surface
 /// with its wrench in its own frame at every state, or null where it is not in contact.
 struct StateContacts {
   std::vector<ContactSurface> surfaces;
@@ -218,10 +218,10 @@ Runner addDynamics(CLI::App& command) {
   command.add_option("--robot", o->robot, "URDF file")->required()->check(CLI::ExistingFile);
   command.add_option("--reference-body", o->referenceBody,
                      "link held fixed at reference_pose (default: the URDF root); any link, sole frames included");
-  command.add_option("--states", o->states, "input JSON (docs/file-formats.md)")->required();
+  command.add_option("--states", o->states, "input JSON (docs/reference/input-files.md)")->required();
   command.add_option("--out", o->out, "output JSON (default: standard output)");
   command.add_option("--contacts", o->contacts,
-                     "contact wrenches per state (JSON, docs/file-formats.md): tau becomes Γ = Γ0 − J1 F, tau0 is Γ0")
+                     "contact wrenches per state (JSON, docs/reference/input-files.md): tau becomes Γ = Γ0 − J1 F, tau0 is Γ0")
       ->check(CLI::ExistingFile);
   command.add_flag("--derivatives", o->derivatives,
                    "add dtau_dq, dtau_dv, dtau_da, dwrench_dq, dwrench_dv, dwrench_da (exact, analytic)");

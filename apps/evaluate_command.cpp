@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt evaluate`: the main job until the optimiser lands (issue 2). Reads a motion
-// file (docs/file-formats.md), evaluates torques, reference-body wrench and electrical
+// file (docs/reference/input-files.md), evaluates torques, reference-body wrench and electrical
 // energy at every sample, prints a summary and optionally writes results atomically.
 #include <chrono>
 #include <iomanip>
@@ -181,7 +181,7 @@ int runEvaluate(const EvaluateOptions& o) {
 
 Runner addEvaluate(CLI::App& command) {
   auto o = std::make_shared<EvaluateOptions>();
-  command.add_option("motion", o->motion, "motion YAML file (docs/file-formats.md)")->required()->check(CLI::ExistingFile);
+  command.add_option("motion", o->motion, "motion YAML file (docs/reference/input-files.md)")->required()->check(CLI::ExistingFile);
   command.add_option("--out", o->out, "folder for result.json and trajectory.csv (written atomically)");
   return [o] { return runEvaluate(*o); };
 }

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt inner`: solve inner contact-force problems given as data (formulation.md §7), one
-// per time sample, with a chosen solver and contact model. Formats: docs/inner-problem.md.
+// per time sample, with a chosen solver and contact model. Formats: docs/theory/inner-problem.md.
 #include <iostream>
 #include <map>
 
@@ -92,14 +92,14 @@ int runInner(const InnerOptions& o) {
 
 Runner addInner(CLI::App& app) {
   auto o = std::make_shared<InnerOptions>();
-  app.add_option("--problems", o->problems, "inner problems (JSON, docs/inner-problem.md)")->required();
+  app.add_option("--problems", o->problems, "inner problems (JSON, docs/theory/inner-problem.md)")->required();
   app.add_option("--solver", o->solver, "active-set (default), slsqp or ipopt");
   app.add_option("--contact-model", o->contactModel, "report (default), pyramid or wrench-cone");
   app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8)");
   app.add_option("--tikhonov", o->tikhonov, "ε added to the objective's Hessian diagonal (default 1e-9)");
   app.add_flag("--cold", o->cold, "do not warm-start each problem from the previous one's result");
   app.add_flag("--polish", o->polish,
-               "slsqp, ipopt: polish each answer on its own active set (linear contact models; docs/inner-problem.md)");
+               "slsqp, ipopt: polish each answer on its own active set (linear contact models; docs/theory/inner-problem.md)");
   app.add_flag("--sensitivity", o->sensitivity,
                "add dwrenches_dtau0 and dwrenches_dbalance (formulation.md §8) to each optimal result");
   app.add_option("--kkt-backend", o->kktBackend, "factorisation of the sensitivity's KKT system: dense (default), klu, umfpack");

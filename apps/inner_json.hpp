@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Inner problems and their results as JSON (docs/inner-problem.md): the one reader of a
+// Inner problems and their results as JSON (docs/theory/inner-problem.md): the one reader of a
 // problem and the one writer of a result, for `mcopt inner` and the Python module alike.
 
 #include <filesystem>

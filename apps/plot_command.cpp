@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt plot RESULT_DIR [--out DIR]`: figures of one optimised motion, PNG and SVG, drawn by
-// scripts/plot_result.py with matplotlib (docs/plots.md).
+// scripts/plot_result.py with matplotlib (docs/guides/plots.md).
 #include <filesystem>
 #include <iostream>
 #include <memory>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt replay RESULT_DIR [--out FILE.html]`: one self-contained page that animates a
-// result in 3-D with three.js (docs/replay.md). The page holds everything it needs — three.js,
+// result in 3-D with three.js (docs/guides/replay.md). The page holds everything it needs — three.js,
 // its orbit controls, the scene, the viewer — so that it opens offline from a file:// URL.
 #include <cstdlib>
 #include <filesystem>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// The scene of a replay (docs/replay.md): what the page draws at each sample of a result —
+// The scene of a replay (docs/guides/replay.md): what the page draws at each sample of a result —
 // every body's world pose, every contact's frame, wrench and centre of pressure in world
 // axes, the centre of mass — computed here by our own kinematics, so that the page only
 // places what it is given.

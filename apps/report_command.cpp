@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt report [--quick] [--out DIR] [--time-limit S] [--docs FILE]`: the report's figures and
-// tables measured on this machine, beside the report's own (docs/benchmarks.md). The
+// tables measured on this machine, beside the report's own (docs/benchmarks/index.md). The
 // measuring is scripts/report.py's: per-evaluation times from mcopt-bench, whole
 // optimisations from this executable's `run` in child processes.
 #include <filesystem>
@@ -51,7 +51,7 @@ Runner addReport(CLI::App& command) {
   command.add_option("--out", o->out, "folder for report.md, report.json and the runs")->capture_default_str();
   command.add_option("--time-limit", o->timeLimit, "seconds after which a whole optimisation is stopped (SIGINT)")
       ->capture_default_str();
-  command.add_option("--docs", o->docs, "a Markdown file whose generated block gets the tables (docs/benchmarks.md)");
+  command.add_option("--docs", o->docs, "a Markdown file whose generated block gets the tables (docs/benchmarks/index.md)");
   return [o] { return report(*o); };
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// What a robot looks like, body by body, for drawing it (mcopt replay, docs/replay.md): the
+// What a robot looks like, body by body, for drawing it (mcopt replay, docs/guides/replay.md): the
 // URDF's visual primitives, or where a link has none, primitives made from its mass
 // properties and its joints, so that a robot described for dynamics alone is drawn too.
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt run`: the project's main job (issue 7). Reads a scenario (docs/scenarios.md),
+// `mcopt run`: the project's main job (issue 7). Reads a scenario (docs/reference/scenario-file.md),
 // optionally optimises the static start and end postures (report §3.5), then optimises the
 // whole motion with Ipopt (formulation.md §10), printing a line per iteration, and writes
 // the results atomically. Ctrl-C (SIGINT) or SIGTERM stops Ipopt at the end of the current
@@ -228,7 +228,7 @@ int runMotion(const RunOptions& o) {
 
 Runner addRun(CLI::App& command) {
   auto o = std::make_shared<RunOptions>();
-  command.add_option("scenario", o->scenario, "scenario YAML file (docs/scenarios.md)")->required()->check(CLI::ExistingFile);
+  command.add_option("scenario", o->scenario, "scenario YAML file (docs/reference/scenario-file.md)")->required()->check(CLI::ExistingFile);
   command.add_option("--out", o->out, "folder for result.json, trajectory.csv, power_fine.csv, states.json")
       ->capture_default_str();
   command.add_option("--configuration-optimisation", o->configurationOptimisation,
@@ -244,7 +244,7 @@ Runner addRun(CLI::App& command) {
       ->check(CLI::IsMember(innerSolverNames()));
   command.add_option("--hessian", o->hessian,
                      "override the scenario's hessian and every continuation stage's; stages left differing in "
-                     "nothing else are dropped (docs/scenarios.md, \"Hessian and convergence\")")
+                     "nothing else are dropped (docs/theory/outer-problem.md, \"Hessian options\")")
       ->check(CLI::IsMember(hessianOptionNames()));
   command.add_option("--start-from", o->startFrom,
                      "a result folder (or its result.json): start from its motion instead of the interpolated one; "

@@ -38,7 +38,7 @@ std::string gravityWarning(const EnergyBalance& balance, double energy) {
   std::ostringstream what;
   what << std::setprecision(3) << "the motion draws " << balance.gravityReleased() << " J from gravity, more than its criterion's "
        << energy << " J: its start is higher than its end. Energies compare between motions that end where they start "
-       << "(end: {same_as: start}; docs/scenarios.md, \"Energy balance\")";
+       << "(end: {same_as: start}; docs/reference/scenario-file.md, \"Energy balance\")";
   return what.str();
 }
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// What a scenario's run leaves (docs/scenarios.md, "Results"): result.json, trajectory.csv,
+// What a scenario's run leaves (docs/reference/results.md, "Results"): result.json, trajectory.csv,
 // power_fine.csv, states.json (the sampled states as a `mcopt dynamics` input) and
 // contact_wrenches.json, each written atomically so that an interrupted run never leaves a
 // half-written file. `mcopt run` writes them; the Python module returns result.json's
@@ -33,7 +33,7 @@ struct RunFiles {
 /// (empty when it does not).
 std::string gravityWarning(const EnergyBalance& balance, double energy);
 
-/// Where the energy of a motion goes, as result.json's `energy_balance` (docs/scenarios.md,
+/// Where the energy of a motion goes, as result.json's `energy_balance` (docs/reference/results.md,
 /// "Energy balance").
 nlohmann::ordered_json energyBalanceJson(const EnergyBalance& balance);
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt study`: sweeps of scenarios run as studies (docs/studies.md).
+// `mcopt study`: sweeps of scenarios run as studies (docs/reference/studies.md).
 //   mcopt study SWEEP.yaml [--jobs N | --slurm [--wait]] [--out DIR]   prepare, then run the unfinished cases
 //   mcopt study collect DIR [--no-plots]                                 cases.csv and summary plots
 //   mcopt study case DIR K                                               one case (what pool processes and array tasks run)
@@ -175,7 +175,7 @@ int runOneCase(const StudyOptions& o) {
 
 Runner addStudy(CLI::App& command) {
   auto o = std::make_shared<StudyOptions>();
-  command.add_option("sweep", o->sweep, "sweep YAML file (docs/studies.md)")->check(CLI::ExistingFile);
+  command.add_option("sweep", o->sweep, "sweep YAML file (docs/reference/studies.md)")->check(CLI::ExistingFile);
   command.add_option("--out", o->out, "the study folder (default out/study_<sweep name>)");
   command.add_option("--jobs", o->jobs, "cases at a time on this machine (default: cores / resources.threads)")
       ->check(CLI::PositiveNumber);

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // OuterHessian/Kick100/hrp2/<option>: one evaluation of the Lagrangian's Hessian of the
 // bundled kick's motion problem (100 samples, 150 spline parameters) at its initial motion,
-// with unit multipliers, for each `hessian:` option that evaluates one (docs/scenarios.md,
+// with unit multipliers, for each `hessian:` option that evaluates one (docs/theory/outer-problem.md,
 // "Hessian and convergence"); beside it Gradient/OneContact100/hrp2 (bench_sensitivity.cpp)
 // and the whole problem's gradient and Jacobian (OuterGradient/Kick100/hrp2), the unit
 // these options are counted in. OuterGradient/weight_shift/<formulation>[/<inner solver>]:

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
 # The report's Table 3.1 experiment on the kick with the report's free ends (scenarios/hrp2_kick_free_ends.yaml;
-# docs/scenarios.md, "Table 3.1"):
+# docs/benchmarks/table-3-1.md, "Table 3.1"):
 # the same motion optimisation with and without configuration optimisation, reporting the
 # final criterion, the exact energy, the iterations and the wall time of each run.
 #   bench/table_3_1.sh [OUT_DIR]            (needs build/release/apps/mcopt)
@@ -36,6 +36,10 @@ run converged-without "$scenario" off
 run lbfgs2000-with "$out/hrp2_kick_lbfgs.yaml" on --max-iterations 2000
 run lbfgs2000-without "$out/hrp2_kick_lbfgs.yaml" off --max-iterations 2000
 
+cpu="$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -1)"
+commit="$(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo 'not a git checkout')"
+printf 'Measured by bench/table_3_1.sh on %s: %s, %s cores, commit %s, OMP_NUM_THREADS=%s.\n\n' \
+  "$(date -u '+%Y-%m-%d %H:%M UTC')" "$cpu" "$(nproc)" "$commit" "${OMP_NUM_THREADS:-unset}"
 printf '| run | configuration optimisation | status | final criterion [J] | energy [J] | max violation | iterations | time [s] |\n'
 printf '|---|---|---|---|---|---|---|---|\n'
 for name in converged-with converged-without lbfgs2000-with lbfgs2000-without; do

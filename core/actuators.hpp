@@ -40,7 +40,7 @@ struct ActuatorSet {
 /// URDF <dynamics> damping/friction (joint side, equal to motor side when N = 1).
 ActuatorSet defaultActuators(const RobotModel& robot);
 
-/// Reads an actuator YAML file (docs/robot-files.md); values not given keep the URDF
+/// Reads an actuator YAML file (docs/reference/robot-files.md); values not given keep the URDF
 /// defaults. Throws InputError naming file, line and field for unknown joints or keys,
 /// wrong types and impossible numbers.
 ActuatorSet loadActuators(const std::filesystem::path& path, const RobotModel& robot);

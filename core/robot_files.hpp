@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // Side files that complete a URDF: contact surfaces and named postures
-// (formulation.md §2; formats in docs/robot-files.md).
+// (formulation.md §2; formats in docs/reference/robot-files.md).
 
 #include <Eigen/Core>
 #include <filesystem>

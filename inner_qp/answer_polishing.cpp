@@ -68,7 +68,7 @@ ContactProblem withBandRows(const ContactProblem& p, double band) {
 /// anywhere along the near-flat directions, the rows tight there are not the minimiser's, and
 /// the solution on them leaves the admissible set; its least slack is then right to the square
 /// root of its objective's accuracy only, and phase 2 (the objective at that balance) moved by
-/// 50 to 109 N of wrench for 1e-5 N of slack on the weight shift (docs/inner-problem.md,
+/// 50 to 109 N of wrench for 1e-5 N of slack on the weight shift (docs/theory/inner-problem.md,
 /// "Polishing").
 std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings,
                                     const std::vector<int>& rows, Eigen::VectorXd& x) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Polishing the third-party solvers' answers (docs/inner-problem.md, "Polishing"; private
+// Polishing the third-party solvers' answers (docs/theory/inner-problem.md, "Polishing"; private
 // header): each answer of SLSQP or Ipopt on a linear contact model solved again exactly, by
 // crossover through our dual active-set QP from the rows the solver's multipliers hold, or on
 // those rows, so that the elastic flow (inner_nlp.hpp) gets the QP's own point and a

@@ -28,7 +28,7 @@ struct InnerSettings {
   int maxIterations = 500;
   bool warmStart = true;           ///< active-set method: start from the result passed in (its active set and wrenches)
   /// SLSQP and Ipopt: polish each answer on its own active set (linear contact models; the
-  /// report model's cones are left as solved). docs/inner-problem.md, "Polishing".
+  /// report model's cones are left as solved). docs/theory/inner-problem.md, "Polishing".
   bool polish = false;
 };
 

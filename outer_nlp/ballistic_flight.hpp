@@ -8,7 +8,7 @@
 // is the apex's height above the target: where it is negative the ball never reaches that
 // height (τ and L are then taken at the apex, D clipped to 0, and a row holds the apex ≥ 0).
 // Every quantity comes with its exact gradient and Hessian in (p, v) (the Hessians for the
-// exact outer Hessian, docs/scenarios.md, "The exact Hessian").
+// exact outer Hessian, docs/theory/outer-problem.md, "The exact Hessian").
 
 #include <Eigen/Core>
 #include <array>

@@ -2,7 +2,7 @@
 #pragma once
 // Derivative stencils that are exact — up to rounding, not up to a truncation error — on the
 // functions the `exact` Hessian option differentiates (outer_nlp/motion_hessian.cpp;
-// docs/scenarios.md, "Hessian and convergence"): along one state component a sample's
+// docs/theory/outer-problem.md, "Hessian options"): along one state component a sample's
 // weighted output gradient is a polynomial of known degree in a velocity, an acceleration or
 // a force variable, and a trigonometric polynomial of known degree in a revolute joint's angle
 // (rigid motions are first-degree in cos q and sin q).

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Where a motion's energy goes (docs/scenarios.md, "Energy balance"), on a fine grid of the
+// Where a motion's energy goes (docs/reference/scenario-file.md, "Energy balance"), on a fine grid of the
 // motion: the joints' net mechanical work, the change of the robot's potential and kinetic
 // energy, the work of the environment contacts (zero when they hold), a thrown ball's energy,
 // and on the motors' side the rotors' kinetic energy, the Joule losses, the friction, and the

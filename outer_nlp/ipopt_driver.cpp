@@ -263,13 +263,13 @@ IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, c
   app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
   app->Options()->SetIntegerValue("max_iter", 3000);
   // MUMPS's maximum-transversal permutation made each factorisation of the motion problem's
-  // KKT system 5× slower (0.5 s against 0.1 s an iteration, HRP-2 kick; docs/scenarios.md).
+  // KKT system 5× slower (0.5 s against 0.1 s an iteration, HRP-2 kick; docs/reference/scenario-file.md).
   app->Options()->SetIntegerValue("mumps_permuting_scaling", 0);
   // MUMPS's automatic choice of ordering was not the same from one run to the next on the
   // epigraph form's KKT system: the offset-free kick's epigraph stage took 3 s in some runs and
   // 74-107 s in others (its dense fronts factorised pivot by pivot), with results that differed
   // in their last bits. AMF, the one it chose on the smooth kick, gives the same iterate and
-  // time every run (docs/scenarios.md, "Ipopt options we set").
+  // time every run (docs/reference/scenario-file.md, "Ipopt options we set").
   app->Options()->SetIntegerValue("mumps_pivot_order", 2);
   for (const SolverOption& o : settings.options) apply(*app, o);
   if (app->Initialize() != Ipopt::Solve_Succeeded) throw InputError("Ipopt could not be initialised");

@@ -22,7 +22,7 @@ enum class OuterStatus {
   FeasiblePointFound, Diverging, RestorationFailed, ErrorInStepComputation, InvalidNumber, TooFewDegreesOfFreedom,
   InvalidOption, OutOfMemory, InternalError
 };
-/// "running", "optimal", "acceptable", "maximum_iterations", … (docs/scenarios.md, "Results").
+/// "running", "optimal", "acceptable", "maximum_iterations", … (docs/reference/results.md, "Results").
 const char* toString(OuterStatus status);
 
 struct IpoptOutcome;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The Lagrangian's Hessian of the motion problem by per-sample differences (formulation.md
-// §10; docs/scenarios.md, "Hessian and convergence").
+// §10; docs/theory/outer-problem.md, "Hessian options").
 //
 // At a fixed duration, every sample row and the objective's share of sample s depend on the
 // spline parameters only through that sample's state z_s = (q, q̇, q̈) — linearly, z_s = B_s x
@@ -185,7 +185,7 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
   // J_j the rows (∇Γ_j, e_q̇j, e_q̈j). Left out: Σ_o λ_o ∇²y_o and (c σ' + λ_P) ∂P/∂Γ ∇²Γ_j, the
   // curvature of the outputs themselves. The cross terms of ∇²P (the mechanical power Γem Ω
   // is bilinear) make H_s indefinite; dropping them (a positive semidefinite model) was
-  // measured: the kick did not converge in 3000 iterations (docs/scenarios.md).
+  // measured: the kick did not converge in 3000 iterations (docs/reference/scenario-file.md).
   const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
   auto H = h.stateHessian.topLeftCorner(d, d);
   H.setZero();
@@ -481,7 +481,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
   }
 
   // Summed in sample order, whatever thread computed each term: the same Hessian, to the
-  // bit, for any thread count (docs/scenarios.md, "Determinism").
+  // bit, for any thread count (docs/developers/determinism.md, "Determinism").
   Eigen::MatrixXd& hessian = hessianSum_;
   hessian.setZero(curved, curved);
   for (const LocalHessian& l : localHessians_)

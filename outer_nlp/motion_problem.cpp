@@ -119,8 +119,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   if (scenario_.hessian == HessianOption::Exact)
     if (const std::string why = exactHessianRefusal(scenario_); !why.empty()) throw InputError("hessian: exact: " + why);
   if (scenario_.hessian == HessianOption::Exact) {
-    // The degree of a weighted output gradient along one state component (docs/scenarios.md,
-    // "Hessian and convergence"; tests/core/test_dynamics_degree.cpp): Γ and the reference
+    // The degree of a weighted output gradient along one state component (docs/reference/scenario-file.md,
+    // "Hessian options"; tests/core/test_dynamics_degree.cpp): Γ and the reference
     // wrench are trigonometric of degree 2 in each joint angle (a moved body's world-frame
     // inertia X* I X⁻¹ is second-degree in cos q, sin q; its velocity and acceleration
     // first-degree), quadratic in q̇, affine in q̈ and in the force variables. The report
@@ -693,7 +693,7 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   // Fixed chunks of consecutive samples, each evaluated in order by one thread: a bilevel
   // sample without a result of its own (the first evaluation) is warm-started from its
   // predecessor in the chunk. The chunks, not the thread count, decide every warm start, so
-  // the results are the same, to the bit, for any thread count (docs/scenarios.md, "Determinism").
+  // the results are the same, to the bit, for any thread count (docs/developers/determinism.md, "Determinism").
   const int chunks = (count + kWarmStartChunk - 1) / kWarmStartChunk;
   {
     // After the first evaluation of its kind every buffer is sized: no Eigen allocation here

@@ -119,7 +119,7 @@ class MotionProblem final : public NlpProblem {
  public:
   /// `omittedTorqueRows` (empty, or one flag per joint and sample, index s · n + j) leaves
   /// those torque-limit rows out of the NLP: torque-limit screening (formulation.md §10;
-  /// docs/scenarios.md), where rows far from their bound are checked after the solve
+  /// docs/reference/scenario-file.md), where rows far from their bound are checked after the solve
   /// instead of weighing on every KKT factorisation.
   explicit MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows = {});
   /// Per joint and sample (index s · n + j): whether |Γ_js| < fraction · its limit at x

@@ -23,14 +23,14 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     // form: it differs in its Hessian or its limit) is not run: Ipopt's optimality test reads
     // the exact first derivatives, whatever Hessian shaped the steps, and a restart from the
     // optimum only wanders (the bundled kick's sample-differences stage after an optimal
-    // Gauss–Newton stage: 48 iterations, 7.6 s, the same optimum; docs/scenarios.md).
+    // Gauss–Newton stage: 48 iterations, 7.6 s, the same optimum; docs/reference/scenario-file.md).
     if (!last && solved && posesScenarioProblem(stageScenario, *solved)) continue;
     const std::unique_ptr<MotionProblem> stageProblem = last ? nullptr : std::make_unique<MotionProblem>(stageScenario);
     MotionProblem& full = last ? problem : *stageProblem;
     // A stage of another energy form lays out other variables after the shared spline
     // parameters and T (the epigraph's slacks): it starts from the motion reached, its own
     // variables set from it (MotionProblem::pointFrom; the smooth maximum's optimum, then the
-    // exact epigraph form: docs/scenarios.md, "Continuation").
+    // exact epigraph form: docs/theory/outer-problem.md, "Continuation").
     if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
     std::vector<bool> omitted;
     if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
@@ -58,13 +58,13 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       // A later stage, and a screening round, starts at the iterate the last solve ended on: a
       // small barrier parameter keeps Ipopt near it instead of re-centring it (measured on the
       // bilevel weight shift: from the Gauss–Newton stage's iterate, sample-differences ended
-      // optimal after 79 iterations with it, and not in 1000 without it; docs/scenarios.md).
+      // optimal after 79 iterations with it, and not in 1000 without it; docs/reference/scenario-file.md).
       // So does the first solve from a given motion (--start-from: another run's optimum).
       // The epigraph form starts lower still: its slacks start at max(P, 0), on their bounds,
       // and a barrier μ lifts each by about 2μ/c (c the sample's weight in the criterion, the
       // smooth maximum's offset with ε = 2μ/c): at 1e-4 the kick's 3000 slacks rose to a
       // criterion of 0.6 J before coming back, 161 iterations with the exact Hessian and none
-      // in 400 with gauss-newton; at 1e-6, 47 and 55 to the same optimum (docs/scenarios.md,
+      // in 400 with gauss-newton; at 1e-6, 47 and 55 to the same optimum (docs/reference/scenario-file.md,
       // "Continuation"). Ours first: the scenario's `solver` options still override it.
       if (k > 0 || stage.rounds > 0 || scenario.initialMotion) {
         const bool epigraph = stageScenario.energyForm == EnergyForm::Epigraph;
@@ -81,7 +81,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       // So is every later stage's and screening round's start, the iterate the last solve ended
       // on: measured, the second stage after 500 Gauss–Newton iterations then took 59 instead
       // of 86 iterations on the weight shift, 49 instead of 63 on the one-foot throw, 48
-      // instead of 59 on the kick without configuration optimisation (docs/scenarios.md).
+      // instead of 59 on the kick without configuration optimisation (docs/reference/scenario-file.md).
       if (k > 0 || stage.rounds > 0 || scenario.initialMotion.has_value())
         for (const char* push : {"bound_push", "bound_frac", "slack_bound_push", "slack_bound_frac"}) {
           SolverOption o;
@@ -114,7 +114,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     // iteration limit) and ends optimal has solved that problem: Ipopt's optimality test reads
     // the exact first derivatives, whatever Hessian shaped the steps. The later stages would
     // only restart from its optimum (measured: a restart with sample-differences wandered off
-    // the lean reach's optimum; docs/scenarios.md).
+    // the lean reach's optimum; docs/reference/scenario-file.md).
     const bool scenarioProblem = posesScenarioProblem(stageScenario, scenario);
     if (!last && scenarioProblem && usable && outcome.optimal()) {
       result.solver = outcome;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A scenario's whole motion solve (docs/scenarios.md, "Continuation" and "Torque-limit
+// A scenario's whole motion solve (docs/theory/outer-problem.md, "Continuation" and "Torque-limit
 // screening"): its continuation stages, each from the previous one's iterate, then its own
 // problem; every solve with the torque-limit rows below `limits.torque_screening` of their
 // limit left out and checked on its result, those that reached it joining for another solve.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Whether the robot can hold the scenario's fixed postures at rest (docs/scenarios.md, "Fixed
+// Whether the robot can hold the scenario's fixed postures at rest (docs/reference/scenario-file.md, "Fixed
 // postures the robot cannot hold"), checked before the optimisation: a fixed start or end
 // posture whose centre of mass lies outside the support polygon of the contacts active at that
 // instant, or whose static torques exceed a joint's limit, makes every motion of the problem

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A motion-optimisation scenario (docs/scenarios.md): the robot and its side files, the
+// A motion-optimisation scenario (docs/reference/scenario-file.md): the robot and its side files, the
 // reference body, the contacts, the duration and samples, the objective, the limits, the
 // tasks, the initialisation and Ipopt's options (formulation.md §10). loadScenario
 // validates everything and names file, line and field in every error.
@@ -73,7 +73,7 @@ const char* toString(ContactForces forces);
 /// "bilevel", "splines" or "variables"; throws InputError otherwise (the message lists them).
 ContactForces parseContactForces(const std::string& name);
 
-/// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/scenarios.md, "Hessian
+/// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/theory/outer-problem.md, "Hessian
 /// and convergence").
 enum class HessianOption {
   LimitedMemory,      ///< Ipopt's quasi-Newton (L-BFGS) approximation, as the report
@@ -143,7 +143,7 @@ struct Scenario {
   std::vector<EnvironmentContact> contacts;  ///< the other contacts, in the file's order
   /// Closure of the environment contacts as a box on the pose error at the samples: a spline
   /// motion stays on the closed chain's (non-polynomial) manifold only up to such a band
-  /// (docs/scenarios.md, "Multi-contact").
+  /// (docs/theory/outer-problem.md, "Multi-contact").
   double closurePositionTolerance = 1e-3;     ///< [m]
   double closureOrientationTolerance = 1e-3;  ///< [rad], on sin θ of the error rotation
   ContactForces contactForces = ContactForces::Bilevel;
@@ -165,7 +165,7 @@ struct Scenario {
   bool positionLimits = true, velocityLimits = true, torqueLimits = true;
   /// Torque-limit rows whose |Γ| stays below this fraction of the limit are left out of the
   /// NLP and checked after the solve; rows that reach it join and the problem is solved
-  /// again (docs/scenarios.md, "Torque-limit screening"). 0: every row in the NLP.
+  /// again (docs/theory/outer-problem.md, "Torque-limit screening"). 0: every row in the NLP.
   double torqueScreening = 0.5;
   std::vector<TaskSpec> tasks;
   /// A throw task's ball (at most one throw a scenario); its two rows are in `tasks`.
@@ -187,13 +187,13 @@ struct Scenario {
   std::optional<InitialMotion> initialMotion;
 
   std::vector<SolverOption> solverOptions;
-  HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/scenarios.md)
+  HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/theory/outer-problem.md)
 
   /// Problems solved before this one, each from the previous one's result (the first from
   /// the initial motion), with a smoother friction model and/or smooth maximum: the dry
   /// friction's steep atan(ν N q̇) makes the kick's Lagrangian indefinite at every joint that
   /// is nearly still, and Newton's steps need hundreds of iterations there
-  /// (docs/scenarios.md, "Hessian and convergence"). The scenario's own problem is solved last.
+  /// (docs/theory/outer-problem.md, "Hessian options"). The scenario's own problem is solved last.
   struct ContinuationStage {
     double frictionSharpness = 0.0;  ///< ν [s/rad]
     double smoothing = 0.0;          ///< ε [W]
@@ -202,12 +202,12 @@ struct Scenario {
     int maxIterations = -1;          ///< Ipopt's max_iter for the stage; -1: the scenario's
     /// The stage's energy form: a smooth-maximum stage before the exact epigraph form, whose
     /// slack variables the next stage sets at max(P, 0) of the motion reached (MotionProblem::
-    /// pointFrom; docs/scenarios.md, "Continuation").
+    /// pointFrom; docs/theory/outer-problem.md, "Continuation").
     EnergyForm energyForm = EnergyForm::SmoothMaximum;
     /// The contact-force formulations the stage runs with (`for_contact_forces`); empty: every
     /// one. A hand-over stage that helps one formulation may hinder another (measured on the
     /// weight shift: Gauss–Newton first makes the bilevel run converge in seconds and keeps the
-    /// `variables` one from converging; docs/scenarios.md, "Multi-contact"), and
+    /// `variables` one from converging; docs/theory/outer-problem.md, "Multi-contact"), and
     /// `mcopt run --contact-forces` chooses the formulation after the file is read.
     std::vector<ContactForces> forContactForces;
     /// Whether the stage runs with that formulation.

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A scenario's whole run (docs/scenarios.md): the optional configuration optimisation of its
+// A scenario's whole run (docs/reference/scenario-file.md): the optional configuration optimisation of its
 // end postures (report §3.5), then the motion solve with its continuation stages and
 // torque-limit screening (motion_solve.hpp), gathered into one RunRecord. The command line
 // (`mcopt run`) and the Python module both run scenarios through here and only differ in

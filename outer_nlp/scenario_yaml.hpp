@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
 // A scenario already parsed as YAML (a study's case after its fields are changed,
-// docs/studies.md; the Python module's Scenario). outer_nlp links yaml-cpp privately: this is
+// docs/reference/studies.md; the Python module's Scenario). outer_nlp links yaml-cpp privately: this is
 // its one header with yaml-cpp types, and a target including it links yaml-cpp itself
 // (tests/header_boundaries.cmake).
 
@@ -15,7 +15,7 @@
 
 namespace mcopt {
 
-/// The `throw` task (formulation.md §10; docs/scenarios.md, "Throw"; outer_nlp/throw_task.cpp):
+/// The `throw` task (formulation.md §10; docs/reference/scenario-file.md, "Throw"; outer_nlp/throw_task.cpp):
 /// `node` is tasks[i] with `kind: throw`; appends its two rows (TaskKind::ThrowLanding,
 /// ThrowRelease) to s.tasks and sets s.ball. Needs the robot, the duration and the gravity read.
 void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, Scenario& s);

@@ -45,7 +45,7 @@ void evaluateTask(const DynamicsModel& model, const DynamicsData& data, const Ta
                   Eigen::Ref<Eigen::Matrix3Xd> dv);
 
 /// A throw task's rows weighted by their multipliers λ, Σ_i λ_i f_i(k) with k = (p, v_p) the
-/// ball's state, split for the exact Hessian in (q, q̇) (docs/scenarios.md, "The exact
+/// ball's state, split for the exact Hessian in (q, q̇) (docs/theory/outer-problem.md, "The exact
 /// Hessian"): ∇² = J_kᵀ (Σ λ_i ∇²f_i) J_k + Σ_m w_m ∇²k_m, w = Σ λ_i ∇f_i. The flight's own
 /// curvature, the first term, goes to `flightCurvature` (2n × 2n); the weights w on the ball's
 /// state go to `ballWeights`, held at the point while a stencil differentiates

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// The Python module `mcopt` (docs/python.md): one bind function per family, and the
+// The Python module `mcopt` (docs/reference/python.md): one bind function per family, and the
 // conversions they share. Values cross as numpy arrays (float64, C order) and dicts; every
 // array argument is checked for its shape and element type before it reaches C++, so a
 // wrong array is a Python exception naming the argument, never a crash.

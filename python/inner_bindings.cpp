@@ -2,7 +2,7 @@
 // mcopt.InnerProblem, mcopt.InnerSolver, mcopt.InnerResult: the inner contact-force problem
 // of one time sample (formulation.md §7) and its sensitivity (§8), what `mcopt inner` solves.
 // A problem given as arrays goes through the reader of `mcopt inner`'s JSON problems, so it
-// is checked, and refused, exactly as a problem file is (docs/inner-problem.md).
+// is checked, and refused, exactly as a problem file is (docs/theory/inner-problem.md).
 #include <pybind11/stl.h>
 
 #include "apps/inner_json.hpp"
@@ -92,7 +92,7 @@ void bindInner(py::module_& m) {
 One sample's inner problem (formulation.md §7): the contact wrenches F_i (in each contact's
 frame) that minimise Σ w Γ² + l Γ with Γ = tau0 − wrench_to_torque · F, subject to the balance
 B F = W and each contact's model (report, pyramid or wrench-cone). Built from arrays (the
-fields of a `mcopt inner` problem, docs/inner-problem.md) or from a robot state and contact
+fields of a `mcopt inner` problem, docs/theory/inner-problem.md) or from a robot state and contact
 surfaces (InnerProblem.from_state).)doc")
       .def(py::init([](const py::object& contacts, const py::object& wrenchToTorque, const py::object& tau0,
                        const py::object& balance, const py::object& weights, const py::object& linear,
@@ -182,7 +182,7 @@ J1 from the contact frames, w = R/(K N)² and l from the actuators (formulation.
           py::arg("wrenches"), "Largest violation of the balance, the linear rows and the cones (0 when feasible).")
       .def(
           "to_dict", [](const InnerProblemHandle& p) { return toPython(p.toJson()); },
-          "The problem as an element of a `mcopt inner` problems file (docs/inner-problem.md).");
+          "The problem as an element of a `mcopt inner` problems file (docs/theory/inner-problem.md).");
 
   py::class_<InnerResultHandle, std::shared_ptr<InnerResultHandle>>(m, "InnerResult", R"doc(
 An inner solver's result: status ('optimal', 'infeasible' with the least-norm balance slack, or

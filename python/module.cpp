@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The Python module `mcopt` (docs/python.md): robot models, dynamics and their derivatives,
+// The Python module `mcopt` (docs/reference/python.md): robot models, dynamics and their derivatives,
 // the inner contact-force problem with its solvers and sensitivity, and scenarios run with
 // a progress callback. The command line's readers and writers are shared (apps/), so the
 // module returns what the CLI writes and refuses what it refuses, with the same messages.

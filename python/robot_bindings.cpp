@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// mcopt.Robot: a URDF with its side files (formulation.md §2, docs/robot-files.md).
+// mcopt.Robot: a URDF with its side files (formulation.md §2, docs/reference/robot-files.md).
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
@@ -42,7 +42,7 @@ std::vector<std::string> namesOf(const std::vector<Named>& elements) {
 void bindRobot(py::module_& m) {
   py::class_<RobotHandle, std::shared_ptr<RobotHandle>>(m, "Robot", R"doc(
 A robot model: a URDF (fixed joints merged, joints in URDF order) with its actuator file and
-contact surfaces (docs/robot-files.md). Errors in any file raise mcopt.InputError with the
+contact surfaces (docs/reference/robot-files.md). Errors in any file raise mcopt.InputError with the
 command line's message (file, line or element, field).)doc")
       .def(py::init<const std::filesystem::path&, const std::optional<std::filesystem::path>&,
                     const std::optional<std::filesystem::path>&, bool>(),
@@ -97,7 +97,7 @@ rectangles a contact can use. `allow_nonphysical_inertia` turns invalid inertias
             for (const auto& [name, q] : loadPostures(file, *r.model)) out[py::str(name)] = vectorToNumpy(q);
             return out;
           },
-          py::arg("file"), "The named postures of a postures file (docs/robot-files.md), joint arrays in URDF order.")
+          py::arg("file"), "The named postures of a postures file (docs/reference/robot-files.md), joint arrays in URDF order.")
       .def("__repr__", [](const RobotHandle& r) {
         return "<mcopt.Robot " + r.model->name + ": " + std::to_string(r.model->jointCount()) + " joints>";
       });

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// mcopt.Scenario: a scenario file (docs/scenarios.md) whose fields can be read and changed by
-// field path (the sweep's paths, docs/studies.md), and run like `mcopt run` with a progress
+// mcopt.Scenario: a scenario file (docs/reference/scenario-file.md) whose fields can be read and changed by
+// field path (the sweep's paths, docs/reference/studies.md), and run like `mcopt run` with a progress
 // callback, the GIL released while it runs and Ctrl-C ending it with its last iterate.
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
@@ -107,7 +107,7 @@ study::FieldPath pathArgument(const std::string& text) {
   }
 }
 
-/// A refused value, said as a sweep says it (docs/studies.md): the value set from Python has
+/// A refused value, said as a sweep says it (docs/reference/studies.md): the value set from Python has
 /// no line in the file, so the loader's location is replaced by the field and its value.
 std::string refusal(const std::string& message, const std::filesystem::path& file, const std::string& path,
                     const YAML::Node& value) {
@@ -188,8 +188,8 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
 
 void bindScenario(py::module_& m) {
   py::class_<ScenarioHandle, std::shared_ptr<ScenarioHandle>>(m, "Scenario", R"doc(
-A motion-optimisation scenario (docs/scenarios.md). Fields are read and changed by field path,
-as a sweep names them (docs/studies.md): `s["samples"] = 40`, `s["tasks[kick].target[0]"]`,
+A motion-optimisation scenario (docs/reference/scenario-file.md). Fields are read and changed by field path,
+as a sweep names them (docs/reference/studies.md): `s["samples"] = 40`, `s["tasks[kick].target[0]"]`,
 `s["inner.solver"] = "slsqp"`. Every change is validated by the scenario loader at once; a
 refused value raises mcopt.InputError with the loader's message and leaves the scenario as it
 was. `run()` optimises it as `mcopt run` does.)doc")

@@ -51,6 +51,9 @@ tools=(
   "cmd:hostname        the local cluster's node name (scripts/slurm-local.sh)"
   "cmd:timeout         the study's time limits and tests"
   "cmd:awk             scripts/slurm-local.sh"
+  "cmd:mkdocs          the documentation site's strict build (tests/python/test_docs.py)"
+  "py:yaml             the reference drift tests (tests/python/test_reference.py)"
+  "py:markdown         the anchors' slugs, as mkdocs makes them (tests/python/test_docs.py)"
 )
 
 command -v dpkg-query >/dev/null && command -v apt-cache >/dev/null ||

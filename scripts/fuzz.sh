@@ -5,7 +5,7 @@
 # found before (build/fuzz/corpus/<target>/), after replaying every regression input of
 # tests/fuzz/regressions/<target>/. Exits non-zero on a finding: a crash, a sanitizer report,
 # an exception other than the CLI's InputError, a hang (> 10 s an input), a leak, or more than
-# 2 GiB of memory; the input is left in build/fuzz/findings/. docs/fuzzing.md.
+# 2 GiB of memory; the input is left in build/fuzz/findings/. docs/developers/fuzzing.md.
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

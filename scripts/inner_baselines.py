@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Fair baselines for the inner contact-force solvers (issue 19, docs/inner-problem.md).
+"""Fair baselines for the inner contact-force solvers (issue 19, docs/theory/inner-problem.md).
 
 Random feasible inner problems of the report contact model (formulation.md §7) are each
 solved twice over: by an independent conic solver — CVXOPT's coneqp, an interior-point

@@ -10,7 +10,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev            # Eigen 3.4
   coinor-libipopt-dev      # Ipopt 3.11 (MUMPS)
-  libopenblas0-serial      # OpenBLAS as the system BLAS/LAPACK under MUMPS: Ipopt's factorisations twice as fast as the reference BLAS (docs/scenarios.md)
+  libopenblas0-serial      # OpenBLAS as the system BLAS/LAPACK under MUMPS: Ipopt's factorisations twice as fast as the reference BLAS (docs/reference/scenario-file.md)
   libnlopt-cxx-dev         # NLopt 2.7
   libsuitesparse-dev       # SuiteSparse 5.12
   liburdfdom-dev           # urdfdom
@@ -18,13 +18,14 @@ packages=(
   libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libbenchmark-dev         # Google Benchmark
   python3-matplotlib       # plots (scripts/plot_*.py) and the Python example
-  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (docs/python.md) and its tests
+  pybind11-dev python3-dev python3-numpy python3-pytest   # the Python module (docs/reference/python.md) and its tests
   python3-cvxopt           # the independent conic reference of the inner baselines (scripts/inner_baselines.py)
   slurm-wlm munge          # studies as Slurm job arrays; scripts/slurm-local.sh and its test
-  libjs-three              # three.js, inlined into the pages of `mcopt replay` (docs/replay.md)
+  libjs-three              # three.js, inlined into the pages of `mcopt replay` (docs/guides/replay.md)
   chromium                 # headless browser of the replay's test
-  clang libclang-rt-14-dev libomp-14-dev   # the libFuzzer targets (scripts/fuzz.sh, docs/fuzzing.md)
+  clang libclang-rt-14-dev libomp-14-dev   # the libFuzzer targets (scripts/fuzz.sh, docs/developers/fuzzing.md)
   llvm                     # llvm-symbolizer: LeakSanitizer names the frames its suppressions match (tests/fuzz/lsan.supp)
+  mkdocs                   # the documentation site: mkdocs build --strict (mkdocs.yml, tests/python/test_docs.py)
 )
 
 if [ "${1:-}" = --list ]; then

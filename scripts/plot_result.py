@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Figures of one optimised motion (docs/plots.md), from the result folder `mcopt run` wrote:
+"""Figures of one optimised motion (docs/guides/plots.md), from the result folder `mcopt run` wrote:
 joint positions and torques within their limits, contact wrenches and friction-cone margins,
 centres of pressure inside their rectangles, power per joint and cumulative energy,
 Ipopt's convergence, and a throw's ball flight to its target. Called by `mcopt plot`; needs matplotlib (Debian's python3-matplotlib).

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Summary plots of a study (docs/studies.md, "Collecting"): the energy of each case against
+"""Summary plots of a study (docs/reference/studies.md, "Collecting"): the energy of each case against
 each varied field, from the study's cases.csv. Called by `mcopt study collect`; needs
 matplotlib (Debian's python3-matplotlib).
 

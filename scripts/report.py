@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""The measurements behind `mcopt report` (docs/benchmarks.md): the analogues of the report's
+"""The measurements behind `mcopt report` (docs/benchmarks/index.md): the analogues of the report's
 Figure 5.1 (one-contact dynamic model and gradient), Figure 5.2 (multi-contact dynamic model,
 gradient and whole optimisation for each contact-force formulation and inner solver), Table
 3.1 (the kick with and without configuration optimisation) and the whole optimisations of the
@@ -129,7 +129,7 @@ def optimisations(mcopt, source, work, quick, time_limit):
     scenarios = pathlib.Path(source) / "scenarios"
     runs = {}
     # Table 3.1 with both boundary conventions: the report's free ends, and the bundled kick,
-    # which returns to its start (docs/scenarios.md, "Boundary").
+    # which returns to its start (docs/reference/scenario-file.md, "Boundary").
     for kick, file in (("kick-free-ends", "hrp2_kick_free_ends.yaml"), ("kick", "hrp2_kick.yaml")):
         for init in ("on", "off"):
             runs[f"{kick}/configuration-{init}"] = run(mcopt, scenarios / file, work / f"{kick}-{init}",
@@ -141,7 +141,7 @@ def optimisations(mcopt, source, work, quick, time_limit):
             label = f"{name}/{forces}" + (f"/{solver}" if solver else "")
             arguments = ["--contact-forces", forces] + (["--inner-solver", solver] if solver else []) + extra
             runs[label] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / label.replace("/", "-"), arguments, time_limit)
-    # The throws (docs/scenarios.md, "Throw"), each as bundled; --quick: the double-support one.
+    # The throws (docs/reference/scenario-file.md, "Throw"), each as bundled; --quick: the double-support one.
     for name in ("throw",) if quick else ("throw", "throw_one_foot", "throw_hand_support", "throw_free_release"):
         runs[name] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / name, extra, time_limit)
     return runs

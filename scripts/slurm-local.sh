@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
 # A real single-node Slurm cluster on loopback, for tests and for trying `mcopt study --slurm`
-# (docs/studies.md): munged, slurmctld and slurmd from Debian's munge and slurm-wlm, started
+# (docs/reference/studies.md): munged, slurmctld and slurmd from Debian's munge and slurm-wlm, started
 # as plain daemons (no systemd) with a generated key and slurm.conf in one folder.
 #
 #   scripts/slurm-local.sh start [DIR]   start the cluster; prints the `export SLURM_CONF=…` to use

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: BSD-3-Clause
 # Installs the dependencies, then builds and runs the whole test suite twice:
 # Release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer.
-# Then each libFuzzer target briefly (scripts/fuzz.sh, docs/fuzzing.md): MCOPT_FUZZ_SECONDS a
+# Then each libFuzzer target briefly (scripts/fuzz.sh, docs/developers/fuzzing.md): MCOPT_FUZZ_SECONDS a
 # target (default 20; 0 skips). Set MCOPT_SKIP_SANITIZE=1 to run only the first.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

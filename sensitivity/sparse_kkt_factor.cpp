@@ -45,7 +45,7 @@ struct SparseKktFactor::Impl {
     klu_defaults(&common);
     umfpack_di_defaults(control);
     // No iterative refinement: it made each of the 3n right-hand sides cost several solves
-    // (BilevelGradient/TwoContacts100/hrp2/umfpack 23.0 → 8.3 ms, docs/sensitivity.md), and the
+    // (BilevelGradient/TwoContacts100/hrp2/umfpack 23.0 → 8.3 ms, docs/theory/sensitivity.md), and the
     // dense and KLU paths, equally accurate here (the tests' 1e-9 agreement), refine nothing;
     // ill-conditioned systems go to the least-norm solve instead.
     control[UMFPACK_IRSTEP] = 0;

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Runs one case of a study (docs/studies.md, "Running a case"): what a local pool's process and
+// Runs one case of a study (docs/reference/studies.md, "Running a case"): what a local pool's process and
 // a Slurm array task execute (`mcopt study case DIR K`).
 
 #include <csignal>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// cases.csv (docs/studies.md, "Collecting"): one row a case — its index, the varied fields'
+// cases.csv (docs/reference/studies.md, "Collecting"): one row a case — its index, the varied fields'
 // values, status, energy, max violation, iterations, time and host.
 
 #include <vector>

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A field of a scenario named by a path (docs/studies.md, "Field paths"): keys joined by dots,
+// A field of a scenario named by a path (docs/reference/studies.md, "Field paths"): keys joined by dots,
 // list elements by [index] or by [name] — the element whose `name` field is that name:
 // `samples`, `inner.solver`, `tasks[kick].target[0]`, `contacts[1].window[0]`.
 

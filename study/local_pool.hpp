@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A study's cases on this machine (docs/studies.md, "Local pool"): `jobs` case runners at a
+// A study's cases on this machine (docs/reference/studies.md, "Local pool"): `jobs` case runners at a
 // time, each a process `mcopt study case DIR K` (Ipopt with MUMPS is not safe twice in one
 // process), each dying with the pool.
 

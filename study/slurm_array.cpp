@@ -45,7 +45,7 @@ std::string arrayRanges(const std::vector<std::size_t>& indices) {
 std::string arrayScript(const StudyFolder& folder, const Sweep& sweep, const std::vector<std::size_t>& cases,
                         const std::filesystem::path& mcopt) {
   const std::filesystem::path root = std::filesystem::absolute(folder.root()).lexically_normal();
-  std::string s = "#!/bin/bash\n# A study's cases as a Slurm job array, written by `mcopt study --slurm` (docs/studies.md).\n";
+  std::string s = "#!/bin/bash\n# A study's cases as a Slurm job array, written by `mcopt study --slurm` (docs/reference/studies.md).\n";
   s += "# Sweep " + std::filesystem::absolute(sweep.file).lexically_normal().string() + "\n";
   s += "#SBATCH --job-name=mcopt-study\n";
   s += "#SBATCH --array=" + arrayRanges(cases) + "\n";

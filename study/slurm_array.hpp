@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A study's cases as one Slurm job array (docs/studies.md, "Slurm"): one array task a case,
+// A study's cases as one Slurm job array (docs/reference/studies.md, "Slurm"): one array task a case,
 // each running `mcopt study case DIR $SLURM_ARRAY_TASK_ID`, submitted with sbatch.
 
 #include <cstddef>

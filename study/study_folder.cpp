@@ -55,7 +55,7 @@ Json studyJson(const Sweep& sweep, const std::vector<StudyCase>& cases) {
   return study;
 }
 
-/// Statuses a restart does not run again (docs/scenarios.md, "Results"): the solver ended.
+/// Statuses a restart does not run again (docs/reference/results.md, "Results"): the solver ended.
 bool finalStatus(const std::string& status) { return !status.empty() && status != "running" && status != "interrupted"; }
 
 }  // namespace

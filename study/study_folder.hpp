@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A study's folder (docs/studies.md, "The study folder"): study.json (the design and the
+// A study's folder (docs/reference/studies.md, "The study folder"): study.json (the design and the
 // resources), one folder per case with its scenario, the result folder of `mcopt run`, the
 // runner's record and the run's log; slurm/ for array scripts and their output; cases.csv and
 // plots/ from `mcopt study collect`. Every file is written atomically.

@@ -108,7 +108,7 @@ void check(const Sweep& sweep, const YAML::Node& root, const std::string& origin
   }
 }
 
-/// One entry of `vary:` (docs/studies.md, "The sweep file").
+/// One entry of `vary:` (docs/reference/studies.md, "The sweep file").
 VariedField readVariedField(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, bool grid) {
   yaml::rejectUnknownKeys(file, node, field, {"field", "values", "range", "scale", "integer"});
   VariedField f;

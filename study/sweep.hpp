@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A sweep (docs/studies.md): a base scenario, fields set for every case, and fields varied by a
+// A sweep (docs/reference/studies.md): a base scenario, fields set for every case, and fields varied by a
 // design — a grid of listed values, or a seeded random or Latin-hypercube design over lists and
 // numeric ranges. Each case is the base scenario with its fields changed, validated by the
 // scenario loader itself before anything is written or submitted.

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The replay page's own code (docs/replay.md): places what the scene gives at the instant
+// The replay page's own code (docs/guides/replay.md): places what the scene gives at the instant
 // shown, interpolating between samples (positions linearly, orientations by slerp), and
 // reports what it shows in #mcopt-state so that a test can check it.
 (function () {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Determinism (issue 19, docs/scenarios.md "Determinism"): the same input gives the same
+// Determinism (issue 19, docs/developers/determinism.md "Determinism"): the same input gives the same
 // output, to the bit, with 1 and 2 OpenMP threads and from run to run — every number of
 // result.json but the clocks', and every side file byte for byte.
 #include <yaml-cpp/yaml.h>
@@ -88,7 +88,7 @@ TEST_CASE("determinism: the bilevel weight shift, inner solves warm-started, wit
 
 // While InnerNlp left the elastic phase's band rows unwritten, SLSQP read whatever its
 // constraint buffer held, and this run's 12th iteration differed in the seventh digit with
-// the output folder's name (docs/inner-problem.md, "Determinism").
+// the output folder's name (docs/theory/inner-problem.md, "Determinism").
 TEST_CASE("determinism: the bilevel weight shift with SLSQP inside, whatever the heap held before", "[cli][determinism]") {
   const test::TempDir dir;
   const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt inner` as a user meets it: the JSON problems of docs/inner-problem.md in, one
+// `mcopt inner` as a user meets it: the JSON problems of docs/theory/inner-problem.md in, one
 // result per problem out, the same answers as the library, clear errors for bad input.
 #include <catch2/catch.hpp>
 #include <fstream>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt plot` (issue 16, docs/plots.md): every figure of a result drawn as PNG and SVG, the
+// `mcopt plot` (issue 16, docs/guides/plots.md): every figure of a result drawn as PNG and SVG, the
 // plotted cumulative energy equal to result.json's, and results it cannot read refused.
 #include <yaml-cpp/yaml.h>
 

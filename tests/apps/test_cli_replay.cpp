@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt replay` (issue 16, docs/replay.md): the page's scene against the result it is drawn
+// `mcopt replay` (issue 16, docs/guides/replay.md): the page's scene against the result it is drawn
 // from — every body at every sample, the contact force in world axes equal to the wrench the
 // environment applies (W0 with one contact) — and results it cannot draw refused. The page in
 // a browser: tests/python/test_replay.py.
@@ -81,7 +81,7 @@ TEST_CASE("replay: one page holding three.js, the viewer and the scene of the re
     CHECK(sole["active"][k].get<bool>());
     for (int i = 0; i < 3; ++i) {
       CHECK(sole["poses"][k][i].get<double>() == Approx(0.0).margin(1e-9));
-      // With one contact its force, in world axes, is W0's force (docs/scenarios.md).
+      // With one contact its force, in world axes, is W0's force (docs/reference/scenario-file.md).
       CHECK(sole["force"][k][i].get<double>() == Approx(result["reference_wrench"][k][i].get<double>()).margin(1e-5));
     }
   }

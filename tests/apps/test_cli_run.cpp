@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt run` as a user meets it (issue 7, docs/scenarios.md): Ipopt's derivative checker on
+// `mcopt run` as a user meets it (issue 7, docs/theory/outer-problem.md): Ipopt's derivative checker on
 // the bundled scenario, the result files, torques reproduced by `mcopt dynamics`, an
 // interrupted run, a killed run's checkpoint, and a message naming file, line and field for every class of bad input.
 #include <yaml-cpp/yaml.h>
@@ -65,7 +65,7 @@ using mcopt::test::readJson;
 TEST_CASE("run: Ipopt's derivative checker finds no error on the bundled scenario", "[cli][run]") {
   // Forward differences: Ipopt's default step 1e-8 is below the objective's round-off (an
   // energy summed over 3000 powers) and 1e-6 above its curvature; 5e-8 resolves both on the
-  // periodic kick (docs/scenarios.md; at 1e-7 one Jacobian entry is flagged at 1.6e-4 and at
+  // periodic kick (docs/reference/scenario-file.md; at 1e-7 one Jacobian entry is flagged at 1.6e-4 and at
   // 3.3e-4 with 2e-7: the forward difference's truncation, which central differences in
   // tests/outer_nlp do not show). With configuration optimisation's end postures (a posture with CoM
   // over the sole), which fix the first and last control points; Ipopt draws the others
@@ -104,7 +104,7 @@ TEST_CASE("run: Ipopt's second-order derivative checker finds no error on the bu
   // range, a fast motion whose dry friction is saturated. Its forward differences err by
   // h ∂³L / 2, and the friction's third derivative at Ω = 0 is large: at 1e-7 one entry of
   // 8 samples' check came out at 1.7e-4 (3.4e-4 at 2e-7), at 5e-8 the whole check is clean
-  // (docs/scenarios.md, "Ipopt's derivative checker"). Ipopt 3.11's second-order check costs
+  // (docs/theory/outer-problem.md, "Ipopt's derivative checker"). Ipopt 3.11's second-order check costs
   // rows × variables² × Hessian entries (16 min at 8 samples): two samples and 7 control
   // points here, every kind of row present; tests/outer_nlp/test_motion_hessian.cpp holds
   // every entry at 100 samples.
@@ -411,7 +411,7 @@ TEST_CASE("run: a continuation solves its stages in turn, each from the last one
 
 TEST_CASE("run: a smooth-maximum stage before the exact epigraph form, whose slacks start at max(P, 0) of its motion",
           "[cli][run]") {
-  // The offset-free criterion (docs/scenarios.md, "Continuation"): the epigraph stage starts
+  // The offset-free criterion (docs/theory/outer-problem.md, "Continuation"): the epigraph stage starts
   // at the smooth stage's motion with every slack at max(P, 0) and Ipopt told to keep it, so
   // its iterate 0 — the written result when its own limit is 0 — has the criterion of that
   // motion's exact energy. With Ipopt's default pushes of 1e-2 off the slacks' bound it did not.
@@ -452,7 +452,7 @@ TEST_CASE("run: a smooth-maximum stage before the exact epigraph form, whose sla
 
 TEST_CASE("run: the offset-free kick — gauss-newton on the smooth maximum, then the epigraph with the exact Hessian — ends optimal",
           "[cli][run]") {
-  // docs/scenarios.md, "Hessian and convergence" and "Continuation": the route that makes the criterion the
+  // docs/theory/outer-problem.md, "Hessian options" and "Continuation": the route that makes the criterion the
   // energy. On 20 samples, measured: 459 + 58 iterations, criterion within 0.1 % of the energy. The
   // epigraph stage's barrier starts at 1e-6, low enough not to lift its slacks off the motion's
   // energy: its criterion rose 0.4 % at most (at 1e-4, by 91 % in its first 5 iterations).
@@ -488,7 +488,7 @@ TEST_CASE("run: the offset-free kick — gauss-newton on the smooth maximum, the
 
 TEST_CASE("run: a continuation stage with its own Hessian option and iteration limit", "[cli][run]") {
   // The bundled multi-contact scenarios start with a few hundred gauss-newton iterations and
-  // finish with sample-differences (docs/scenarios.md): each stage says its option, stops at its
+  // finish with sample-differences (docs/reference/scenario-file.md): each stage says its option, stops at its
   // own limit (not the scenario's), and the next starts from its iterate.
   const test::TempDir dir;
   const auto scenario = kickVariant(dir, [](YAML::Node& root) {
@@ -523,7 +523,7 @@ TEST_CASE("run: a Hessian-only stage that ends optimal ends the run", "[cli][run
     // stage's code paths run in the test above; the Release build runs both cases.
     if (kUnderSanitizers) continue;
     // The free-ends kick: its epigraph form converges with Gauss–Newton steps (the periodic
-    // bundled kick's needs the exact Hessian, docs/scenarios.md, "Boundary").
+    // bundled kick's needs the exact Hessian, docs/theory/outer-problem.md, "Boundary").
     const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_kick_free_ends.yaml", dir, [&](YAML::Node& root) {
       root["samples"] = 12;
       root["hessian"] = "sample-differences";  // the stage differs in its Hessian alone
@@ -757,7 +757,7 @@ TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages
 
 TEST_CASE("run: a continuation stage for some formulations runs only with them", "[cli][run][multi-contact]") {
   // The bundled weight shift's Gauss–Newton hand-over stage is for the bilevel formulation
-  // alone (docs/scenarios.md, "Multi-contact"); here on 12 samples, one iteration a stage.
+  // alone (docs/theory/outer-problem.md, "Multi-contact"); here on 12 samples, one iteration a stage.
   const test::TempDir dir;
   const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
     root["samples"] = 12;
@@ -891,7 +891,7 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
     CHECK(readJson(out / "result.json")["inner"]["solver"] == solver);
   }
   // inner.polish reaches the inner solver: SLSQP's answers polished on their active sets
-  // (docs/inner-problem.md, "Polishing"), counted per iteration; never the active-set method's.
+  // (docs/theory/inner-problem.md, "Polishing"), counted per iteration; never the active-set method's.
   for (const bool polish : {false, true}) {
     const auto variant = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
       root["samples"] = 8;
@@ -922,7 +922,7 @@ TEST_CASE("run: the variables formulation started from the bilevel optimum start
           "[cli][run][multi-contact]") {
   // formulation.md §9: the bilevel optimum's wrenches are a feasible point of the single-level
   // formulations, so from it `variables` (which optimises the wrenches with the motion) can only
-  // do as well or better. docs/scenarios.md, "Multi-contact: the same physics".
+  // do as well or better. docs/theory/outer-problem.md, "Multi-contact: the same physics".
   if (kUnderSanitizers) return;  // two whole optimisations: the Release build runs them
   const test::TempDir dir;
   const auto leanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
@@ -945,7 +945,7 @@ TEST_CASE("run: the variables formulation started from the bilevel optimum start
   CHECK(start.at("violation").get<double>() <= 1e-6);
   const double bilevelCriterion = first.at("objective_value").get<double>();
   CHECK(second.at("objective_value").get<double>() <= bilevelCriterion * (1.0 + 1e-6));
-  // Both optima's energy balance (docs/scenarios.md, "Energy balance"): the joints' and contacts'
+  // Both optima's energy balance (docs/reference/scenario-file.md, "Energy balance"): the joints' and contacts'
   // work is the change of mechanical energy (fixed start and end: none), the contacts held.
   for (const Json* optimum : {&first, &second}) {
     const Json& balance = optimum->at("energy_balance");

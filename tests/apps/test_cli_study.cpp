@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt study` as a user meets it (issue 17, docs/studies.md): a sweep on the local pool and
+// `mcopt study` as a user meets it (issue 17, docs/reference/studies.md): a sweep on the local pool and
 // as a Slurm job array on a real single-node cluster (scripts/slurm-local.sh) giving the same
 // cases.csv, restarts after a killed pool and after scancel that run only the unfinished
 // cases, a case stopped at its time limit, and bad sweep files refused before anything runs.

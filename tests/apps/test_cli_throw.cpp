@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt run` on a throw (issue 15, docs/scenarios.md "Throw"): the bundled throw ends optimal
+// `mcopt run` on a throw (issue 15, docs/reference/scenario-file.md "Throw"): the bundled throw ends optimal
 // and its ball, computed here from the result's own q and q̇ at the release by forward
 // kinematics (not the optimiser's rows), lands within 1 mm of the target, and `mcopt plot`
 // draws its flight; every class of bad throw is refused with file, line and field.
@@ -97,7 +97,7 @@ Json runThrowAndCheckItsBall(const std::filesystem::path& scenario, const test::
     CHECK(result.at("max_violation").get<double>() <= 1e-6);
     CHECK(miss <= 1e-3);
   }
-  // The energy balance of the motion reached (docs/scenarios.md, "Energy balance"): the joints'
+  // The energy balance of the motion reached (docs/reference/scenario-file.md, "Energy balance"): the joints'
   // and contacts' work is the robot's change of mechanical energy plus what the ball took away.
   const Json& balance = result.at("energy_balance");
   const double ball = balance.at("ball_energy_J").get<double>();
@@ -128,7 +128,7 @@ TEST_CASE("throw: the bundled throw ends optimal and its ball lands on the targe
   CHECK_THAT(plot.output, Contains("result.json energy "));
 }
 
-// The bundled variants (docs/scenarios.md, "Throw: measured"), each to its optimum: one case
+// The bundled variants (docs/reference/scenario-file.md, "Throw: measured"), each to its optimum: one case
 // each, so that CTest runs them side by side.
 TEST_CASE("throw: the one-foot throw ends optimal and its ball lands on the target", "[cli][run][throw]") {
   const test::TempDir dir;
@@ -139,7 +139,7 @@ TEST_CASE("throw: the hand-supported throw ends optimal and its ball lands on th
   // On a grid of 0.1 s (25 samples, the release at 1.4 s one of them) instead of the bundled
   // 0.04 s: the same contacts, window, ball and formulation, optimal after 472 Gauss–Newton
   // iterations, ~30 s on one thread, where the bundled 61 samples take ~4 minutes (905
-  // iterations; docs/scenarios.md, "Throw: measured"), too long for the CI budget.
+  // iterations; docs/reference/scenario-file.md, "Throw: measured"), too long for the CI budget.
   const test::TempDir dir;
   const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_throw_hand_support.yaml", dir,
                                               [](YAML::Node& root) { root["samples"] = 25; }, "hand_support.yaml");

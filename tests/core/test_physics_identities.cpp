@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Physics checks that need no reference (DEVELOPERS.md "gold" checks), on every robot:
+// Physics checks that need no reference (docs/developers/index.md "gold" checks), on every robot:
 // power balance, invariance under a change of reference body, gravity torques equal to
 // Jacobian-transposed weights, and W0 as the total external wrench in statics.
 #include <catch2/catch.hpp>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt dynamics --states` input (docs/file-formats.md) on HRP-2, with derivatives: the
+// `mcopt dynamics --states` input (docs/reference/input-files.md) on HRP-2, with derivatives: the
 // command's own reader and the dynamics it runs.
 #include "tests/fuzz/fuzz_support.hpp"
 

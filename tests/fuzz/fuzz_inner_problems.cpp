@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// `mcopt inner --problems` input (docs/inner-problem.md): the command's reader, the active-set
+// `mcopt inner --problems` input (docs/theory/inner-problem.md): the command's reader, the active-set
 // solver with warm starts along the problems, and the KKT sensitivity of each result.
 #include "tests/fuzz/fuzz_support.hpp"
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// A URDF with its side files (docs/robot-files.md) as `mcopt robot info` and the scenario
+// A URDF with its side files (docs/reference/robot-files.md) as `mcopt robot info` and the scenario
 // loader read them. The input is the URDF, then optionally the actuator, contact-surface and
 // posture files, each after a line "--- actuators", "--- contacts", "--- postures".
 #include "core/actuators.hpp"

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Scenario YAML as `mcopt run` reads it (docs/scenarios.md): the loader with its side files,
+// Scenario YAML as `mcopt run` reads it (docs/reference/scenario-file.md): the loader with its side files,
 // then the motion problem built from it, up to where Ipopt would start.
 #include "core/errors.hpp"
 #include "outer_nlp/motion_problem.hpp"

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// What the fuzz targets share (docs/fuzzing.md): each input is written where the command line
+// What the fuzz targets share (docs/developers/fuzzing.md): each input is written where the command line
 // would read it, and read through the command's own code. A bad input may end in InputError —
 // the CLI's clear "file: field:" message, exit code 2 — or in a refused command line; anything
 // else (a crash, a sanitizer report, another exception, which the CLI would print as an

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Runs one fuzz target's LLVMFuzzerTestOneInput on files, without libFuzzer: the seed corpus
 // and every regression input (a crash, hang or sanitizer report found once) in the ordinary
-// test suite, under whatever compiler and sanitizers it is built with (docs/fuzzing.md).
+// test suite, under whatever compiler and sanitizers it is built with (docs/developers/fuzzing.md).
 // Arguments: [--all-accepted] files or folders (every regular file in them, in name order);
 // with --all-accepted (the seed corpora) an input refused with an InputError fails the run:
 // a seed that never reaches past the reader fuzzes nothing.

@@ -2,7 +2,7 @@
 // The inner problem as the NLP solvers see it (inner_qp/inner_nlp.hpp): every value the
 // callbacks report is written, and agrees with the Jacobian they report, in each balance mode.
 // The elastic phase 2's band rows once had a Jacobian and no values, so SLSQP and Ipopt read
-// whatever their buffers held (docs/inner-problem.md, "Determinism").
+// whatever their buffers held (docs/theory/inner-problem.md, "Determinism").
 #include <catch2/catch.hpp>
 #include <limits>
 #include <random>

@@ -140,10 +140,10 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
              << "optimal " << problems << ", worst KKT residual " << worstKkt << "; SLSQP optimal "
              << slsqpTally.optimal << ", at the same optimum " << slsqpTally.sameOptimum << "; Ipopt optimal "
              << ipoptTally.optimal << ", at the same optimum " << ipoptTally.sameOptimum);
-  // The figures docs/inner-problem.md states, as thresholds. The catalogue is seeded and the
+  // The figures docs/theory/inner-problem.md states, as thresholds. The catalogue is seeded and the
   // three solvers are deterministic, so their counts are required exactly as measured. (SLSQP
   // had a margin of 1 % until the elastic phase's band rows reported their values: before, it
-  // read whatever its constraint buffer held, docs/inner-problem.md "Determinism".)
+  // read whatever its constraint buffer held, docs/theory/inner-problem.md "Determinism".)
   CHECK(unloaded >= kMeasured.unloaded);  // the degenerate case the method is built for
   CHECK(ipoptTally.optimal >= kMeasured.ipoptOptimal);
   CHECK(ipoptTally.sameOptimum >= kMeasured.ipoptSame);
@@ -354,14 +354,14 @@ TEST_CASE("warm starts along a smooth motion cut the active-set iterations, not 
   }
   WARN("mean active-set iterations per sample: warm " << double(warmIterations) / kSamples << ", cold "
                                                       << double(coldIterations) / kSamples);
-  // docs/inner-problem.md: warm 3.84, cold 10.73 a sample (seeded, deterministic).
+  // docs/theory/inner-problem.md: warm 3.84, cold 10.73 a sample (seeded, deterministic).
   CHECK(double(warmIterations) / kSamples <= 3.84 + 1e-9);
   CHECK(double(coldIterations) / kSamples >= 10.73 - 1e-9);
 }
 
 TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-set optimum, and certify a slight infeasibility",
           "[inner][solvers][polish]") {
-  // docs/inner-problem.md, "Polishing". Linear models (wrench cone, pyramid): the polished
+  // docs/theory/inner-problem.md, "Polishing". Linear models (wrench cone, pyramid): the polished
   // answer is the active-set method's to rounding, where the raw one is within the solvers'
   // tolerances; a feasible problem is never called infeasible.
   std::mt19937 rng(131);

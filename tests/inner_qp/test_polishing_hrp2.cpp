@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Polishing on HRP-2's own infeasible samples (docs/inner-problem.md, "Polishing"): at the
+// Polishing on HRP-2's own infeasible samples (docs/theory/inner-problem.md, "Polishing"): at the
 // boundary of dynamic balance the elastic phase 2's optimum moves by tens of newtons for 1e-5 N
 // of least slack, so an NLP solver's least-slack point, right in its objective but not in its
 // point, set another phase 2 than the active-set method's; the crossover finishes both phases

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The energy balance (outer_nlp/energy_balance.hpp; docs/scenarios.md, "Energy balance"):
+// The energy balance (outer_nlp/energy_balance.hpp; docs/reference/scenario-file.md, "Energy balance"):
 // the joints' net work plus the environment contacts' work equals the change of the robot's
 // mechanical energy (and a thrown ball's), on every bundled scenario's problem, at motions
 // that are not optima (a held contact is not held there: its work is part of the check); the

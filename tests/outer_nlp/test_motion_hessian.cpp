@@ -178,7 +178,7 @@ Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, 
 }  // namespace
 
 TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jacobian and the states", "[outer][hessian]") {
-  // What the option computes is a model (docs/scenarios.md): this checks that it is the
+  // What the option computes is a model (docs/reference/scenario-file.md): this checks that it is the
   // model it says — the chain through every sample's exact output derivatives, the local
   // supports, the trapezoid weights — on one contact (smooth maximum with regularisation,
   // and the epigraph form) and on the bilevel formulation (Γ through the inner optimum).
@@ -395,7 +395,7 @@ TEST_CASE("exact Hessian: entry by entry where differences can tell, on a smooth
   // With ν = 0.01 s/rad and ε = 1 W twice-extrapolated central differences (O(h⁶)) hold to
   // 1e-7 entry by entry, and the Hessian must match each entry to 1e-6 of max(1, |entry|) —
   // where Ipopt's checker (forward differences) still flags 3 entries of the objective's
-  // Hessian at 1e-4 (docs/scenarios.md).
+  // Hessian at 1e-4 (docs/theory/outer-problem.md).
   Scenario s = kick(16);
   s.actuators.frictionSharpness = 0.01;
   s.smoothing = 1.0;

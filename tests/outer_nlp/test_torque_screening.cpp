@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Torque-limit screening (docs/scenarios.md, "Torque-limit screening"): the motion problem
+// Torque-limit screening (docs/theory/outer-problem.md, "Torque-limit screening"): the motion problem
 // with some torque-limit rows left out is the full problem minus exactly those rows — same
 // objective and gradient, every remaining row with the same value, bounds and Jacobian —, and
 // the rows it leaves out are the ones whose |Γ| is below the fraction of their limit.

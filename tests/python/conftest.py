@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Shared helpers of the Python module's tests (docs/python.md).
+"""Shared helpers of the Python module's tests (docs/reference/python.md).
 
 CTest runs these with the build tree's module on PYTHONPATH and MCOPT_EXECUTABLE naming the
 command line, so that every binding can be compared with what the CLI writes for the same

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""The example of docs/python.md runs as a user would run it, and says what it should."""
+"""The example of docs/reference/python.md runs as a user would run it, and says what it should."""
 import pathlib
 import re
 import subprocess

@@ -63,7 +63,7 @@ def test_solvers_equal_the_cli(mcopt_exe, hrp2, tmp_path, solver, model):
 @pytest.mark.parametrize("solver", ["slsqp", "ipopt"])
 def test_polish_equals_the_cli_and_reaches_the_active_set_optimum(mcopt_exe, hrp2, tmp_path, solver):
     """`polish=True` is `mcopt inner --polish`: each answer solved again on its own active set,
-    the active-set method's optimum to rounding (docs/inner-problem.md, "Polishing")."""
+    the active-set method's optimum to rounding (docs/theory/inner-problem.md, "Polishing")."""
     problems = motion_problems(hrp2, "wrench-cone")
     write_json(tmp_path / "problems.json", {"problems": [p.to_dict() for p in problems]})
     run_cli(mcopt_exe, "inner", "--problems", tmp_path / "problems.json", "--solver", solver, "--contact-model",

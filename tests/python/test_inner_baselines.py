@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""scripts/inner_baselines.py (docs/inner-problem.md, "Against a conic solver"): a reduced run
+"""scripts/inner_baselines.py (docs/theory/inner-problem.md, "Against a conic solver"): a reduced run
 of the comparison — every solver of `mcopt inner` against CVXOPT's conic optimum — and the
 checks that decide "reaches the optimum" failing where they must."""
 import importlib.util

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""Every class, method and property of the module says what it is (docs/python.md)."""
+"""Every class, method and property of the module says what it is (docs/reference/python.md)."""
 import inspect
 
 import mcopt

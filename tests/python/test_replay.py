@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""`mcopt replay` (docs/replay.md) as a person uses it: the page opened in headless Chromium
+"""`mcopt replay` (docs/guides/replay.md) as a person uses it: the page opened in headless Chromium
 from a file:// URL at two instants, with no console error, two screenshots that are neither
 blank nor equal, and the robot where its pose puts it — every body at the position our own
 kinematics (mcopt.Dynamics, not the page's scene) gives for the result's q at that instant,

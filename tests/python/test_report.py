@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: BSD-3-Clause
-"""`mcopt report --quick` (docs/benchmarks.md): the structure of report.json and report.md,
+"""`mcopt report --quick` (docs/benchmarks/index.md): the structure of report.json and report.md,
 the report's own figures beside ours, the generated block of a docs file replaced and nothing
 else, and a whole optimisation stopped at the time limit with its last iterate."""
 import importlib.util

@@ -255,7 +255,7 @@ TEST_CASE("sensitivities from each solver's own result agree with the active-set
   WARN("worst relative difference to the active-set sensitivities: SLSQP " << worst[0] << " (" << compared[0]
                                                                             << " problems), Ipopt " << worst[1] << " ("
                                                                             << compared[1] << ")");
-  // Measured 14 and 15 of 15 (the three solvers are deterministic: docs/inner-problem.md,
+  // Measured 14 and 15 of 15 (the three solvers are deterministic: docs/theory/inner-problem.md,
   // "Determinism").
   CHECK(compared[0] >= 14);
   CHECK(compared[1] >= 15);

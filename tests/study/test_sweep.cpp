@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// Sweeps (docs/studies.md): field paths, the three designs, validation of every case by the
+// Sweeps (docs/reference/studies.md): field paths, the three designs, validation of every case by the
 // scenario loader with errors at the sweep's own lines, array ranges, the study folder.
 #include <sys/wait.h>
 #include <unistd.h>
