@@ -118,7 +118,8 @@ int runEvaluate(const EvaluateOptions& o) {
   const Eigen::VectorXd start = readPosture(o.motion, motion.start, "start", robot, postures);
   const Eigen::VectorXd end = readPosture(o.motion, motion.end, "end", robot, postures);
   if (robot.findFrame(motion.referenceBody) < 0)
-    throw InputError(o.motion + ": reference_body: unknown body '" + motion.referenceBody + "'");
+    throw InputError(o.motion + ": reference_body: unknown body '" + motion.referenceBody + "' " +
+                     robot.unknownFrameHint(motion.referenceBody));
   const DynamicsModel model(robot, motion.referenceBody, motion.referencePose, motion.gravity);
   const MotionParametrization parametrization(robot.jointCount(), motion.controlPoints);
   TrajectoryEvaluator evaluator(model, actuators, SampledTrajectory(parametrization, motion.samples));

@@ -24,8 +24,8 @@ std::vector<ContactSurface> readContactSurfaces(const std::filesystem::path& pat
     const YAML::Node link = yaml::required(path, node, "link", field);
     s.frame = robot.findFrame(yaml::text(path, link, field + ".link"));
     if (s.frame < 0)
-      throw InputError(yaml::where(path, link, field + ".link") + "unknown body '" + link.as<std::string>() +
-                       "' (no such link in " + robot.source + ")");
+      throw InputError(yaml::where(path, link, field + ".link") + "unknown body '" + link.as<std::string>() + "' " +
+                       robot.unknownFrameHint(link.as<std::string>()));
     if (node["position"]) {
       const auto p = yaml::numbers(path, node["position"], field + ".position", 3);
       s.placement.translation = Vector3(p[0], p[1], p[2]);

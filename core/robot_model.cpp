@@ -6,6 +6,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -68,9 +69,42 @@ int RobotModel::findJoint(const std::string& jointName) const {
   return -1;
 }
 
+namespace {
+
+/// Levenshtein distance, case-insensitive: how many single-character edits turn a into b.
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  auto lower = [](char c) { return static_cast<char>(std::tolower(static_cast<unsigned char>(c))); };
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (lower(a[i - 1]) == lower(b[j - 1]) ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string RobotModel::unknownFrameHint(const std::string& frameName) const {
+  std::vector<std::pair<std::size_t, std::string>> ranked;
+  for (const Frame& f : frames) ranked.emplace_back(editDistance(frameName, f.name), f.name);
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  std::string names;
+  for (std::size_t k = 0; k < std::min<std::size_t>(3, ranked.size()); ++k)
+    names += (k ? ", " : "") + ranked[k].second;
+  const std::string file = source.empty() ? "the URDF" : std::filesystem::path(source).filename().string();
+  return "(no such link in " + file + (names.empty() ? "" : "; the nearest link names: " + names) + ")";
+}
+
 int RobotModel::frameIndex(const std::string& frameName) const {
   const int index = findFrame(frameName);
-  if (index < 0) throw InputError(source + ": unknown body '" + frameName + "' (no such link in the URDF)");
+  if (index < 0) throw InputError(source + ": unknown body '" + frameName + "' " + unknownFrameHint(frameName));
   return index;
 }
 

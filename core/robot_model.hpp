@@ -79,6 +79,10 @@ class RobotModel {
   int findFrame(const std::string& frameName) const;  ///< -1 when absent
   int findJoint(const std::string& jointName) const;  ///< -1 when absent
   std::vector<std::string> jointNames() const;
+  /// What to say after "unknown body 'NAME'": "(no such link in FILE; the nearest link
+  /// names: a, b, c)" — the three link names closest to NAME by edit distance, so that a typo
+  /// or another robot's naming convention (l_sole against left_sole_link) leads somewhere.
+  std::string unknownFrameHint(const std::string& frameName) const;
 };
 
 /// The robot carrying a point mass `mass` [kg] at `point` of frame `frame` (its frame's

@@ -89,7 +89,8 @@ TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, con
     const YAML::Node bodyNode = yaml::required(file, node, "body", field);
     t.body = yaml::text(file, bodyNode, field + ".body");
     t.frame = robot.findFrame(t.body);
-    if (t.frame < 0) throw InputError(where(file, bodyNode, field + ".body") + "unknown body '" + t.body + "'");
+    if (t.frame < 0)
+      throw InputError(where(file, bodyNode, field + ".body") + "unknown body '" + t.body + "' " + robot.unknownFrameHint(t.body));
   }
   if (node["point"]) {
     if (t.kind != TaskKind::Position && t.kind != TaskKind::LinearVelocity)
@@ -413,8 +414,19 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
 
   const YAML::Node referenceNode = yaml::required(file, root, "reference_body", "");
   s.referenceBody = yaml::text(file, referenceNode, "reference_body");
-  if (s.robot.findFrame(s.referenceBody) < 0)
-    throw InputError(where(file, referenceNode, "reference_body") + "unknown body '" + s.referenceBody + "'");
+  if (s.robot.findFrame(s.referenceBody) < 0) {
+    // A contact surface's name where a link is expected (l_sole on a robot whose sole link is
+    // left_sole_link): say which link that surface is on.
+    const auto surface = std::find_if(surfaces.begin(), surfaces.end(),
+                                      [&](const ContactSurface& c) { return c.name == s.referenceBody; });
+    if (surface != surfaces.end())
+      throw InputError(where(file, referenceNode, "reference_body") + "unknown body '" + s.referenceBody + "': '" +
+                       s.referenceBody + "' is a contact surface of " + s.contactSurfacesFile.filename().string() +
+                       ", on link '" + s.robot.frames[static_cast<std::size_t>(surface->frame)].name +
+                       "'; reference_body takes a link (its surface is listed in contacts)");
+    throw InputError(where(file, referenceNode, "reference_body") + "unknown body '" + s.referenceBody + "' " +
+                     s.robot.unknownFrameHint(s.referenceBody));
+  }
   if (root["reference_pose"]) {
     const YAML::Node pose = root["reference_pose"];
     yaml::rejectUnknownKeys(file, pose, "reference_pose", {"position", "rpy"});

@@ -41,7 +41,9 @@ void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, co
   const YAML::Node bodyNode = yaml::required(file, node, "body", field);
   ball.body = yaml::text(file, bodyNode, field + ".body");
   ball.frame = s.robot.findFrame(ball.body);
-  if (ball.frame < 0) throw InputError(where(file, bodyNode, field + ".body") + "unknown body '" + ball.body + "'");
+  if (ball.frame < 0)
+    throw InputError(where(file, bodyNode, field + ".body") + "unknown body '" + ball.body + "' " +
+                     s.robot.unknownFrameHint(ball.body));
   if (node["point"]) {
     const auto p = yaml::numbers(file, node["point"], field + ".point", 3);
     ball.point = Vector3(p[0], p[1], p[2]);

@@ -599,8 +599,16 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
          r["duration"] = YAML::Load("{initial: 3.0, min: 1.0, max: 2.0}");
        }, {"duration: expected min ≤ initial ≤ max"}},
       {"unknown reference body", [](YAML::Node& r) { r["reference_body"] = "l_foot_typo"; },
-       {"reference_body: unknown body 'l_foot_typo'"}},
+       {"reference_body: unknown body 'l_foot_typo' (no such link in hrp2.urdf; the nearest link names: "}},
+      // A typo leads to the link meant; a contact surface's name to the link it is on.
+      {"reference body misspelt", [](YAML::Node& r) { r["reference_body"] = "l_sloe"; },
+       {"reference_body: unknown body 'l_sloe' (no such link in hrp2.urdf; the nearest link names: l_sole, "}},
+      {"a contact surface as the reference body", [](YAML::Node& r) { r["reference_body"] = "l_hand"; },
+       {"reference_body: unknown body 'l_hand': 'l_hand' is a contact surface of contacts.yaml, on link 'l_palm'; "
+        "reference_body takes a link"}},
       {"unknown task body", [](YAML::Node& r) { r["tasks"][0]["body"] = "r_hoof"; }, {"tasks[0].body: unknown body 'r_hoof'"}},
+      {"task body misspelt", [](YAML::Node& r) { r["tasks"][0]["body"] = "R_SOLE_"; },
+       {"tasks[0].body: unknown body 'R_SOLE_' (no such link in hrp2.urdf; the nearest link names: r_sole, "}},
       {"unknown task kind", [](YAML::Node& r) { r["tasks"][0]["kind"] = "acceleration"; },
        {"tasks[0].kind: unknown task kind 'acceleration'"}},
       {"task after the end", [](YAML::Node& r) { r["tasks"][0]["time"] = 9.0; }, {"tasks[0].time: after the end"}},
