@@ -198,15 +198,17 @@ RobotModel buildModel(const urdf::ModelInterface& urdfModel, const std::string& 
   model.frames.push_back(Frame{root->name, 0, RigidTransform::identity()});
 
   // Depth-first from the root, children in urdfdom's order (formulation.md §1).
+  std::vector<std::string> mimicOnFixed;  // a <mimic> tag on a fixed joint: merged, the tag has no effect
   std::function<void(const urdf::Link&, int, const RigidTransform&)> visit =
       [&](const urdf::Link& link, int body, const RigidTransform& linkInBody) {
         for (const urdf::JointSharedPtr& urdfJoint : link.child_joints) {
           const urdf::LinkConstSharedPtr child = urdfModel.getLink(urdfJoint->child_link_name);
           const RigidTransform origin = toTransform(urdfJoint->parent_to_joint_origin_transform);
           const std::string where = source + ": joint '" + urdfJoint->name + "'";
-          if (urdfJoint->mimic)
+          if (urdfJoint->mimic && urdfJoint->type != urdf::Joint::FIXED)
             model.warnings.push_back(where + ": <mimic> ignored, the joint is independent");
           if (urdfJoint->type == urdf::Joint::FIXED) {
+            if (urdfJoint->mimic) mimicOnFixed.push_back(urdfJoint->name);
             const RigidTransform childInBody = linkInBody * origin;
             model.bodies[body].inertia.add(readInertia(*child, source, options, model.warnings), childInBody);
             model.frames.push_back(Frame{child->name, body, childInBody});
@@ -253,6 +255,13 @@ RobotModel buildModel(const urdf::ModelInterface& urdfModel, const std::string& 
         }
       };
   visit(*root, 0, RigidTransform::identity());
+  if (!mimicOnFixed.empty()) {
+    std::string names;
+    for (const std::string& n : mimicOnFixed) names += (names.empty() ? "" : ", ") + n;
+    model.warnings.push_back(source + ": <mimic> on " + std::to_string(mimicOnFixed.size()) + " fixed joint" +
+                             (mimicOnFixed.size() > 1 ? "s" : "") + " (" + names +
+                             "): a fixed joint is merged into its parent body, the tag has no effect");
+  }
   // Every link must hang from the root: urdfdom accepts links whose joints form a loop apart
   // from it (found by fuzzing, tests/fuzz/regressions/), and they would be silently missing.
   if (model.frames.size() != urdfModel.links_.size()) {

@@ -113,7 +113,21 @@ TEST_CASE("URDF errors name the file and the element", "[input][urdf]") {
     const RobotModel model = loadUrdfString(xml, "mimic.urdf");
     CHECK(model.jointCount() == 3);
     REQUIRE(model.warnings.size() == 1);
-    CHECK_THAT(model.warnings[0], Contains("joint 'm'") && Contains("mimic"));
+    CHECK_THAT(model.warnings[0], Contains("joint 'm'") && Contains("mimic") && Contains("the joint is independent"));
+  }
+  SECTION("mimic tags on fixed joints: merged, one true warning for all of them") {
+    auto fixedMimic = [](const std::string& name, const std::string& parent, const std::string& child) {
+      return "<joint name=\"" + name + "\" type=\"fixed\"><parent link=\"" + parent + "\"/><child link=\"" + child +
+             "\"/><mimic joint=\"wrist\"/></joint>";
+    };
+    const std::string xml = robot(urdfLink("base") + urdfLink("arm") + urdfLink("hand") + urdfLink("f1") + urdfLink("f2") +
+                                  joint("shoulder", "base", "arm") + joint("wrist", "arm", "hand") +
+                                  fixedMimic("g1", "hand", "f1") + fixedMimic("g2", "hand", "f2"));
+    const RobotModel model = loadUrdfString(xml, "gripper.urdf");
+    CHECK(model.jointCount() == 2);
+    REQUIRE(model.warnings.size() == 1);
+    CHECK_THAT(model.warnings[0], Contains("<mimic> on 2 fixed joints (g1, g2)") && Contains("merged into its parent body") &&
+                                      !Contains("independent"));
   }
 }
 
