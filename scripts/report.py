@@ -155,10 +155,15 @@ def duration(seconds):
     return f"{seconds:.1f} s" if seconds < 600 else f"{seconds / 60:.1f} min"
 
 
-def markdown(report):
+def markdown(report, provenance=True):
+    """The tables. With `provenance` the first line names the run's date and commit (report.md);
+    without it (the docs block) the machine and settings only: a docs page states the current
+    figures, and each run's date and commit go to report.json and the lab notes."""
     m, t, runs, settings = report["machine"], report["benchmarks_ms"], report["optimisations"], report["settings"]
-    lines = [f"Measured by `mcopt report{' --quick' if settings['quick'] else ''}` on {m['date']}: {m['cpu']}, "
-             f"{m['cores']} cores, {m['build_type']} build at {m['commit']}. Per-evaluation times: mcopt-bench, one "
+    when = f" on {m['date']}" if provenance else ""
+    at = f" at {m['commit']}" if provenance else " (date and commit: report.json, and the lab notes' benchmark runs)"
+    lines = [f"Measured by `mcopt report{' --quick' if settings['quick'] else ''}`{when}: {m['cpu']}, "
+             f"{m['cores']} cores, {m['build_type']} build{at}. Per-evaluation times: mcopt-bench, one "
              f"thread, median of {settings['bench']['repetitions']}; whole optimisations: `mcopt run` with "
              f"{settings['run_threads']} OpenMP threads, "
              + ("one Ipopt iteration each (--quick)" if settings["quick"] else
@@ -244,7 +249,7 @@ def main():
         docs = pathlib.Path(a.docs)
         body = docs.read_text()
         head, rest = body.split(BEGIN, 1)
-        write_atomically(docs, head + BEGIN + "\n" + text + rest[rest.index(END):])
+        write_atomically(docs, head + BEGIN + "\n" + markdown(report, provenance=False) + rest[rest.index(END):])
         print(f"mcopt report: {docs} updated")
     print(text)
     print(f"{out / 'report.md'}\n{out / 'report.json'}")

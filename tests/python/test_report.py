@@ -85,6 +85,11 @@ def test_the_docs_block_is_replaced_and_nothing_else(quick):
     assert body.startswith("# Before\n\nkept\n\n" + script.BEGIN + "\n")
     assert body.endswith(script.END + "\n\nafter, kept\n")
     assert "old tables" not in body and "**Figure 5.2**" in body
+    # The docs block states the figures and the machine; the run's date and commit stay in
+    # report.json (and the lab notes), out of the reference page.
+    machine = json.loads((tmp / "report" / "report.json").read_text())["machine"]
+    block = body.split(script.BEGIN, 1)[1]
+    assert machine["commit"] not in block and machine["date"] not in block and machine["cpu"] in block
 
 
 def test_a_docs_file_without_the_block_is_refused(mcopt_exe, tmp_path):
