@@ -68,10 +68,11 @@ mount -t devpts devpts "$root_dir/dev/pts" -o newinstance,ptmxmode=0666 2>/dev/n
 cp /etc/resolv.conf "$root_dir/etc/resolv.conf"
 mkdir -p "$root_dir/src"
 mount --bind -o ro "$source_dir" "$root_dir/src"; mounts+=("$root_dir/src")
+# The home of the root's user, where the clone goes; shared/ beside the clone, as CI has it.
+home_in_root="$root_dir$(chroot "$root_dir" /usr/bin/env -i sh -c 'getent passwd 0 | cut -d: -f6')"
 if [ -n "$shared" ]; then
-  # Beside the clone in root's home, as CI has shared/ beside its clone.
-  mkdir -p "$root_dir/root/shared"
-  mount --bind -o ro "$shared" "$root_dir/root/shared"; mounts+=("$root_dir/root/shared")
+  mkdir -p "$home_in_root/shared"
+  mount --bind -o ro "$shared" "$home_in_root/shared"; mounts+=("$home_in_root/shared")
 fi
 
 # A clean environment, as a login shell of a new machine has it.
