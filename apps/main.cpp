@@ -4,9 +4,11 @@
 
 #include "apps/commands.hpp"
 #include "core/errors.hpp"
+#include "core/version.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"mcopt — whole-body motion optimisation for humanoid robots in multi-contact"};
+  app.set_version_flag("--version", std::string("mcopt ") + mcopt::kVersion);
   app.require_subcommand(1);
   CLI::App* robot = app.add_subcommand("robot", "inspect a robot description");
   robot->require_subcommand(1);

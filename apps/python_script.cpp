@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "apps/data_paths.hpp"
+
 namespace mcopt::cli {
 
 std::string pythonInterpreter() {
@@ -17,13 +19,13 @@ std::string pythonInterpreter() {
 }
 
 std::pair<study::ChildExit, std::string> runPythonScript(const std::string& name, const std::vector<std::string>& arguments) {
-  std::vector<std::string> command = {pythonInterpreter(), (std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / name).string()};
+  std::vector<std::string> command = {pythonInterpreter(), scriptFile(name).string()};
   command.insert(command.end(), arguments.begin(), arguments.end());
   return study::runAndCapture(command);
 }
 
 study::ChildExit runPythonScriptAttached(const std::string& name, const std::vector<std::string>& arguments) {
-  std::vector<std::string> command = {pythonInterpreter(), (std::filesystem::path(MCOPT_SOURCE_DIR) / "scripts" / name).string()};
+  std::vector<std::string> command = {pythonInterpreter(), scriptFile(name).string()};
   command.insert(command.end(), arguments.begin(), arguments.end());
   study::SpawnOptions options;
   options.dieWithParent = true;

@@ -15,7 +15,7 @@ namespace mcopt::cli {
 /// python3-matplotlib installs), else python3 on PATH.
 std::string pythonInterpreter();
 
-/// Runs scripts/NAME of the source tree with the arguments: its exit and standard output
+/// Runs scripts/NAME (apps/data_paths.hpp: installed or in the source tree) with the arguments: its exit and standard output
 /// (its standard error goes to ours).
 std::pair<study::ChildExit, std::string> runPythonScript(const std::string& name, const std::vector<std::string>& arguments);
 

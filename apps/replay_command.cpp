@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "apps/commands.hpp"
+#include "apps/data_paths.hpp"
 #include "apps/json_io.hpp"
 #include "apps/replay_scene.hpp"
 #include "core/atomic_file.hpp"
@@ -63,7 +64,7 @@ int replay(const ReplayOptions& o) {
   const std::filesystem::path orbitScript = three / "examples" / "js" / "controls" / "OrbitControls.js";
   if (!std::filesystem::is_regular_file(threeScript) || !std::filesystem::is_regular_file(orbitScript))
     throw InputError(threeScript.string() + ": three.js not found (install Debian's libjs-three, or set MCOPT_THREE_JS_DIR to a folder with three.min.js and examples/js/controls/OrbitControls.js)");
-  const std::filesystem::path viewer = std::filesystem::path(MCOPT_SOURCE_DIR) / "apps" / "replay";
+  const std::filesystem::path viewer = replayViewerDirectory();
 
   std::string page = fileText(viewer / "viewer.html", "the replay page's template");
   std::string sceneText = scene.dump();

@@ -4,6 +4,7 @@
 // a progress callback. The command line's readers and writers are shared (apps/), so the
 // module returns what the CLI writes and refuses what it refuses, with the same messages.
 #include "core/errors.hpp"
+#include "core/version.hpp"
 #include "python/bindings.hpp"
 
 PYBIND11_MODULE(mcopt, m) {
@@ -15,7 +16,7 @@ derivatives) → InnerProblem / InnerSolver / InnerResult (contact wrenches of o
 their sensitivity) → Scenario (a whole motion optimisation, as `mcopt run`). Arrays are
 numpy float64; joint arrays are in the robot's URDF joint order. Bad input raises
 mcopt.InputError (a ValueError) with the command line's message.)doc";
-  m.attr("__version__") = "0.1.0";
+  m.attr("__version__") = mcopt::kVersion;
   py::register_exception<mcopt::InputError>(m, "InputError", PyExc_ValueError);
   mcopt::python::bindRobot(m);
   mcopt::python::bindDynamics(m);
