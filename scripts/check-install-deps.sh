@@ -52,6 +52,9 @@ tools=(
   "cmd:timeout         the study's time limits and tests"
   "cmd:awk             scripts/slurm-local.sh"
   "cmd:mkdocs          the documentation site's strict build (tests/python/test_docs.py)"
+  "cmd:cpack           the Debian package (cmake/mcoptInstall.cmake, tests/install/check_install.sh)"
+  "cmd:dpkg-shlibdeps  the Debian package's library dependencies (cpack -G DEB)"
+  "cmd:dpkg-deb        the Debian package's fields and its install in a scratch root (tests/install/check_install.sh)"
   "py:yaml             the reference drift tests (tests/python/test_reference.py)"
   "py:markdown         the anchors' slugs, as mkdocs makes them (tests/python/test_docs.py)"
 )

@@ -7,12 +7,17 @@
 # install-deps.sh misses shows here and nowhere else (issue 48). docs/developers/fresh-debian.md.
 #
 #   scripts/rehearse-fresh-debian.sh [--root DIR] [--shared DIR] [--only run|test] [--keep]
+#   scripts/rehearse-fresh-debian.sh --deb FILE [--root DIR] [--keep]
 #
 # --root     where the root is made (default build/fresh-debian in this checkout); emptied first
 # --shared   a shared/ folder put beside the clone, read-only, as CI has it (default: none, as a
 #            newcomer has it)
 # --only     run one of the two commands
 # --keep     leave the root in place afterwards (its mounts are always undone)
+# --deb      instead of the clone and its commands, the Debian package as a user installs it
+#            (`apt-get install ./mcopt_*.deb`, dependencies resolved by apt), then `mcopt --version`,
+#            `mcopt run /usr/share/mcopt/scenarios/hrp2_throw.yaml` to an optimal end, and
+#            `python3 -c "import mcopt"` (docs/getting-started/install.md)
 # The root has /proc, /sys (with no cgroup filesystem: as in a container) and /dev mounted. Its
 # log is DIR.log; the exit status is the first failing command's. Needs root and about 12 GiB.
 set -euo pipefail
@@ -21,16 +26,19 @@ root_dir="$source_dir/build/fresh-debian"
 shared=""
 only=""
 keep=0
+deb=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --root) root_dir="$2"; shift 2 ;;
     --shared) shared="$(cd "$2" && pwd)"; shift 2 ;;
     --only) only="$2"; shift 2 ;;
     --keep) keep=1; shift ;;
-    *) echo "usage: $0 [--root DIR] [--shared DIR] [--only run|test] [--keep]" >&2; exit 2 ;;
+    --deb) deb="$(cd "$(dirname "$2")" && pwd)/$(basename "$2")"; shift 2 ;;
+    *) echo "usage: $0 [--root DIR] [--shared DIR] [--only run|test] [--keep] | --deb FILE [--root DIR] [--keep]" >&2; exit 2 ;;
   esac
 done
 case "$only" in ""|run|test) ;; *) echo "rehearse: --only takes run or test" >&2; exit 2 ;; esac
+[ -z "$deb" ] || [ -f "$deb" ] || { echo "rehearse: $deb: no such package" >&2; exit 2; }
 [ "$(id -u)" -eq 0 ] || { echo "rehearse: needs root (debootstrap, chroot, mount)" >&2; exit 2; }
 mkdir -p "$(dirname "$root_dir")"
 root_dir="$(cd "$(dirname "$root_dir")" && pwd)/$(basename "$root_dir")"
@@ -88,6 +96,20 @@ timed() {  # name, command...
   say "$name: exit $status after $((SECONDS - t0)) s ($(( (SECONDS - t0) / 60 )) min $(( (SECONDS - t0) % 60 )) s)"
   return $status
 }
+
+if [ -n "$deb" ]; then
+  cp "$deb" "$root_dir/tmp/"
+  package="/tmp/$(basename "$deb")"
+  status=0
+  timed "apt-get install ./$(basename "$deb")" "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $package" || status=$?
+  if [ $status -eq 0 ]; then
+    timed "mcopt --version" "mcopt --version" || status=$?
+    timed "mcopt run" "cd ~ && mcopt run /usr/share/mcopt/scenarios/hrp2_throw.yaml --out out/throw && grep -q '\"status\": \"optimal\"' out/throw/result.json" || status=$?
+    timed "import mcopt" "cd / && python3 -c 'import mcopt; print(mcopt.__version__, mcopt.__file__)'" || status=$?
+  fi
+  say "total $((SECONDS - start)) s; log $log"
+  exit $status
+fi
 
 timed "git" "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends git ca-certificates"
 timed "clone" "git clone -q /src ~/mcopt && git -C ~/mcopt log -1 --format='%h %s'"
