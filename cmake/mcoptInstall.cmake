@@ -78,10 +78,14 @@ set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION science)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
-# The module is built for this Python (its ABI tag): python3 of the same minor version.
-math(EXPR mcopt_next_python_minor "${Python3_VERSION_MINOR} + 1")
-set(CPACK_DEBIAN_PACKAGE_DEPENDS
-    "python3 (>= 3.${Python3_VERSION_MINOR}), python3 (<< 3.${mcopt_next_python_minor}), python3-numpy, python3-matplotlib, libjs-three")
+# `mcopt plot` runs python3 with matplotlib; `mcopt replay` inlines libjs-three. The module is
+# built for this Python (its ABI tag): python3 of the same minor version, and numpy.
+set(CPACK_DEBIAN_PACKAGE_DEPENDS "python3, python3-matplotlib, libjs-three")
+if(MCOPT_BUILD_PYTHON)
+  math(EXPR mcopt_next_python_minor "${Python3_VERSION_MINOR} + 1")
+  set(CPACK_DEBIAN_PACKAGE_DEPENDS
+      "python3 (>= 3.${Python3_VERSION_MINOR}), python3 (<< 3.${mcopt_next_python_minor}), python3-numpy, python3-matplotlib, libjs-three")
+endif()
 set(CPACK_DEBIAN_PACKAGE_RECOMMENDS
     "libopenblas0-serial, cmake, pkg-config, libeigen3-dev, coinor-libipopt-dev, libnlopt-cxx-dev, libsuitesparse-dev, liburdfdom-dev, libyaml-cpp-dev, nlohmann-json3-dev")
 set(CPACK_GENERATOR DEB)
