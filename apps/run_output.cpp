@@ -68,7 +68,7 @@ nlohmann::ordered_json energyBalanceJson(const EnergyBalance& b) {
 RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool withEnergyBalance) {
   const Scenario& scenario = problem.scenario();
   const RobotModel& robot = scenario.robot;
-  const Eigen::VectorXd parameters = problem.motionParameters(record.x);
+  const Eigen::VectorXd parameters = problem.reportedMotionParameters(record.x);  // closing joints: a fit of their motion
   const double T = problem.duration(record.x);
   const int n = robot.jointCount();
   const SampledPhysics r = problem.sampledPhysics(record.x);
@@ -149,6 +149,13 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
       contact["closure_drift_rad"] = r.closureRotationDrift[c - 1];
       contact["closure_speed_m_s"] = r.closureSpeed[c - 1];
       contact["closure_angular_speed_rad_s"] = r.closureAngularSpeed[c - 1];
+      // Held over the whole motion: by construction, its loop closed by six joints (closed_chains.hpp).
+      Json closing = Json::array();
+      if (const ClosedChains* chains = problem.closedChains())
+        for (const int j : chains->closingJoints())
+          if (chains->contacts()[static_cast<std::size_t>(chains->contactOf(j))].name == e.surface.name)
+            closing.push_back(scenario.robot.joints[static_cast<std::size_t>(j)].name);
+      contact["closing_joints"] = closing;
     }
     contacts.push_back(contact);
   }

@@ -67,8 +67,9 @@ void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::
     for (int j = 0; j < n; ++j)
       h.weights[outputs_.power(j)] += objectiveWeight * smoothMaximumSlope(b.y[outputs_.power(j)], scenario_.smoothing);
   outputGradient(b, h.weights, gradient);
-  // The regularisation w Σ q̈² (formulation.md §10).
-  gradient.segment(2 * n, n) += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration;
+  // The regularisation w Σ q̈² over the spline joints (formulation.md §10).
+  for (int j = 0; j < n; ++j)
+    if (!closure_ || !closure_->closes(j)) gradient[2 * n + j] += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration[j];
 }
 
 void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights,
@@ -224,7 +225,8 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
     H(a, v) += M(1, 2);
     H(a, a) += M(2, 2);
   }
-  for (int j = 0; j < n; ++j) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
+  for (int j = 0; j < n; ++j)
+    if (!closure_ || !closure_->closes(j)) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
   H.triangularView<Eigen::StrictlyUpper>() = H.transpose();  // the spreading reads the whole matrix
 }
 
@@ -266,6 +268,9 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       h.centreGradient.setZero(largest);
       h.objectiveGradient.setZero(largest), h.stateByDuration.setZero(largest), h.durationRow.setZero(largest);
       h.wrenchJacobian.setZero(6, largest), h.curvedWrenchJacobian.setZero(6, largest);
+      const int closing = 3 * outputs_.closing;
+      h.foldColumns.setZero(largest, closing), h.foldRows.setZero(closing, largest), h.foldDuration.setZero(closing);
+      h.probeMap.setZero(closing, 3 * n), h.closedState.setZero(3 * n);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
     for (LocalHessian& l : localHessians_)  // + 1: the duration's row and column (exact option)
@@ -306,9 +311,46 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     };
     // With `duration`, also the row and column of T from h.durationRow (∂²L/∂z∂T in the
     // state and force columns) and h.durationCurvature (∂²L/∂T²).
+    // With closed chains (`map`, closed_chains.hpp) the state Hessian H, in the full state, is
+    // first brought to the spline joints' by x = T x_F (T the identity on the spline joints, the
+    // map on the closing ones): Tᵀ H T, and Tᵀ on the duration's row — the chain rule of the
+    // gradient, the closure's own curvature left out (a Gauss–Newton term in the map).
     auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
-                      const std::vector<int>& forceColumns, LocalHessian& out, bool duration) {
+                      const std::vector<int>& forceColumns, LocalHessian& out, bool duration, const Eigen::MatrixXd* map) {
       const int k = weights.count, nf = static_cast<int>(forceColumns.size()), d = stateBlocks * n + nf;
+      if (map) {
+        const int c = outputs_.closing, sc = stateBlocks * c;
+        const std::vector<int>& closing = closure_->closingJoints();
+        const auto M = map->topLeftCorner(sc, stateBlocks * n);
+        auto Hfull = h.stateHessian.topLeftCorner(d, d);
+        auto G = h.foldColumns.topLeftCorner(d, sc);
+        for (int block = 0; block < stateBlocks; ++block)
+          for (int kk = 0; kk < c; ++kk) {
+            const int at = block * n + closing[static_cast<std::size_t>(kk)];
+            G.col(block * c + kk) = Hfull.col(at);
+            Hfull.col(at).setZero();
+          }
+        Hfull.leftCols(stateBlocks * n).noalias() += G * M;
+        auto R = h.foldRows.topLeftCorner(sc, d);
+        for (int block = 0; block < stateBlocks; ++block)
+          for (int kk = 0; kk < c; ++kk) {
+            const int at = block * n + closing[static_cast<std::size_t>(kk)];
+            R.row(block * c + kk) = Hfull.row(at);
+            Hfull.row(at).setZero();
+          }
+        Hfull.topRows(stateBlocks * n).noalias() += M.transpose() * R;
+        if (duration) {
+          auto r = h.durationRow.head(d);
+          auto rc = h.foldDuration.head(sc);
+          for (int block = 0; block < stateBlocks; ++block)
+            for (int kk = 0; kk < c; ++kk) {
+              const int at = block * n + closing[static_cast<std::size_t>(kk)];
+              rc[block * c + kk] = r[at];
+              r[at] = 0.0;
+            }
+          r.head(stateBlocks * n).noalias() += M.transpose() * rc;
+        }
+      }
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
       auto weight = [&](int block, int l) {
@@ -355,7 +397,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
         sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
-        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, closure_ ? &b.closureMap : nullptr);
         continue;
       }
       if (exact) {
@@ -377,13 +419,25 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           dz.segment(2 * n, n) -= 2.0 / T * g.segment(2 * n, n);
           dz += cE;
         }
-        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], freeDuration);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], freeDuration, closure_ ? &b.closureMap : nullptr);
         continue;
       }
       auto base = h.base.head(d), gradient = h.gradient.head(d);
       sampleLagrangianGradient(b, lambda, objectiveWeight, h, base);
       samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+      closeState(b, w, nullptr);  // the sample's own state
+      // Closed chains: differences in the spline joints' state, each probe closed again (the
+      // closure's own curvature included), the gradients brought to that state by the map.
+      if (closure_) {
+        foldGradient(b.closureMap, 3, base.head(3 * n));
+        h.closedState << w.q, w.v, w.a;
+      }
       for (int c = 0; c < d; ++c) {
+        const bool state = c < 3 * n;
+        if (closure_ && state && closure_->closes(c % n)) {
+          h.stateHessian.col(c).head(d).setZero();
+          continue;
+        }
         // Perturb one state component (or force variable), evaluate the sample there.
         double* component = c < n           ? &w.q[c]
                             : c < 2 * n     ? &w.v[c - n]
@@ -391,16 +445,19 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                                             : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
         const double saved = *component, step = differenceStep(saved);
         *component = saved + step;
+        if (closure_ && state) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap);
         sampleOutputs(s, h.probeX, true, w, probe);
         *component = saved;
+        if (closure_ && state) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
         sampleLagrangianGradient(probe, lambda, objectiveWeight, h, gradient);
+        if (closure_) foldGradient(state ? h.probeMap : b.closureMap, 3, gradient.head(3 * n));
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       // A bilevel sample keeps its last inner solution (its warm start, its reported status):
       // leave it at the unperturbed state.
       if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
-      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false);
+      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, nullptr);
     }
 
 #pragma omp for schedule(static)
@@ -419,6 +476,12 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       base.head(n).noalias() = b.dyDq.transpose() * lambda;
       if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
       taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+      closeState(b, w, nullptr);
+      const int taskBlocks = velocity ? 2 : 1;
+      if (closure_ && !exact) {  // as the samples': differences in the spline joints' state
+        foldGradient(b.closureMap, taskBlocks, base);
+        h.closedState << w.q, w.v, w.a;
+      }
       const bool durationTerms = exact && freeDuration && velocity;
       // A throw's rows are functions of the ball's state k = (p, v_p): their exact Hessian is the
       // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (task_kinematics.hpp).
@@ -458,12 +521,19 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
             h.stateHessian.col(c).head(d) = column;
           continue;
         }
+        if (closure_ && closure_->closes(c % n)) {
+          h.stateHessian.col(c).head(d).setZero();
+          continue;
+        }
         const double step = differenceStep(saved);
         component = saved + step;
+        if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap);
         taskOutputs(i, true, w, taskProbe);
         component = saved;
+        if (closure_) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
         gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
         if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+        if (closure_) foldGradient(h.probeMap, taskBlocks, gradient);
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       symmetrise(d);
@@ -476,7 +546,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         h.durationCurvature = u.dot(dz) - 2.0 / T * base.tail(n).dot(u.tail(n));
         dz.tail(n) -= base.tail(n) / T;
       }
-      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms);
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms, nullptr);
     }
   }
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/motion_problem.hpp"
 
+#include <Eigen/QR>
+
 #include <omp.h>
 
 #include <algorithm>
@@ -36,6 +38,7 @@ std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInst
   const double T = s.duration.initial;
   for (std::size_t t = 0; t < s.tasks.size(); ++t) {
     const TaskSpec& task = s.tasks[t];
+    if (task.heldThroughout) continue;  // held by construction (closed_chains.hpp)
     if (!task.window) {
       u.push_back(std::min(1.0, task.start / T));
       taskOfInstant.push_back(static_cast<int>(t));
@@ -101,6 +104,7 @@ const char* constraintKindName(ConstraintKind kind) {
     case ConstraintKind::Closure: return "closure";
     case ConstraintKind::Task: return "task";
     case ConstraintKind::Epigraph: return "energy_epigraph";
+    case ConstraintKind::ClosingJointLimit: return "closing_joint_limit";
   }
   return "?";
 }
@@ -141,6 +145,14 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   }
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
+  // Contacts held over the whole motion: closed by construction (closed_chains.hpp).
+  std::vector<HeldContact> held;
+  for (const EnvironmentContact& c : scenario_.contacts)
+    if (!c.window) held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose});
+  // (the exact Hessian option refuses them: exactHessianRefusal, checked above)
+  if (!held.empty()) closure_ = std::make_unique<ClosedChains>(model_, std::move(held), scenario_.start);
+  const int closing = closure_ ? closure_->closingCount() : 0;
+  outputs_.closing = closing;
   // Trapezoid weights as fractions of T: c_s / (N − 1), halved at the ends and, with a ball,
   // at the release's two samples (the power jumps there; each side takes its half interval).
   sampleTimes_ = nlpSampleTimes(scenario_);
@@ -188,6 +200,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   const int m = parametrization_.parametersPerJoint();
   for (int j = 0; j < jointCount_ && scenario_.velocityLimits; ++j) {
     if (!std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].velocityLimit)) continue;
+    if (closure_ && closure_->closes(j)) continue;  // its limit is a row at every sample
     for (int k = 0; k + 1 < parametrization_.controlPointCount(); ++k) {
       const int first = parametrization_.parameterOfControlPoint(k), second = parametrization_.parameterOfControlPoint(k + 1);
       if (first == second) continue;  // the clamped ends: identically zero
@@ -196,8 +209,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     }
   }
 
-  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model_, contacts, outputs_.rowsPerContact));
   const int outputs = outputs_.size();
+  workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()),
+                     ThreadWorkspace(model_, contacts, outputs_.rowsPerContact, closure_ ? closure_->contactCount() : 0,
+                                     closing, outputs));
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   for (int s = 0; s < samples_.sampleCount(); ++s) {
     SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
@@ -210,6 +225,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
         for (int c = 0; c < 6; ++c) b.forceColumns.push_back(t.variable + c);
       }
     b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
+    b.closureMap.setZero(3 * closing, 3 * jointCount_);
+    b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     // Local parameters of every sample (the chain rule's column order), fixed for good.
     samples_.chainRule(s, 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
@@ -218,6 +235,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     SampleBlock& b = taskBlocks_[i];
     b.y.setZero(3), b.dyDT.setZero(3);
     b.dyDq.setZero(3, jointCount_), b.dyDv.setZero(3, jointCount_), b.dyDa.setZero(3, jointCount_);
+    b.closureMap.setZero(3 * closing, 3 * jointCount_);
+    b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     taskSamples_.chainRule(static_cast<int>(i), 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
   // Sparsity within a sample: with forces fixed by the formulation's variables, Γ_i (and
@@ -229,12 +248,13 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   for (int i = 0; i < jointCount_; ++i) {
     allJoints_.push_back(i);
     for (int j = 0; j < jointCount_; ++j)
-      if (bilevel_ || model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
+      // Through a closure every output may depend on every joint (its map's columns).
+      if (bilevel_ || closure_ || model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
         relatedJoints_[static_cast<std::size_t>(i)].push_back(j);
   }
   for (const int t : taskOfInstant_) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(t)];
-    if (task.kind == TaskKind::CenterOfMass) {
+    if (task.kind == TaskKind::CenterOfMass || closure_) {
       taskJoints_.push_back(allJoints_);
       continue;
     }
@@ -349,6 +369,14 @@ void MotionProblem::buildStructure() {
     }
     if (bilevel_)
       sampleRow(ConstraintKind::InnerFeasibility, 0, false, s, outputs_.infeasibility(), 1.0, allJoints_, false);
+    for (int k = 0; k < outputs_.closing; ++k) {
+      const int joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
+      if (scenario_.positionLimits)
+        sampleRow(ConstraintKind::ClosingJointLimit, k, false, s, outputs_.closingPosition(k), 1.0, allJoints_, false);
+      if (scenario_.velocityLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit))
+        sampleRow(ConstraintKind::ClosingJointLimit, outputs_.closing + k, false, s, outputs_.closingVelocity(k), 1.0, allJoints_,
+                  false);
+    }
     if (scenario_.energyForm == EnergyForm::Epigraph)
       for (int j = 0; j < jointCount_; ++j) {
         sampleRow(ConstraintKind::Epigraph, j, false, s, outputs_.power(j), -1.0, relatedJoints_[static_cast<std::size_t>(j)],
@@ -388,6 +416,13 @@ std::string MotionProblem::rowName(int row) const {
       break;
     }
     case ConstraintKind::InnerFeasibility: name << "inner problem feasibility (balance slack)"; break;
+    case ConstraintKind::ClosingJointLimit: {
+      const int k = r.detail % outputs_.closing, joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
+      name << (r.detail < outputs_.closing ? "position" : "velocity") << " limit of "
+           << scenario_.robot.joints[static_cast<std::size_t>(joint)].name << " (closing "
+           << closure_->contacts()[static_cast<std::size_t>(closure_->contactOf(joint))].name << ")";
+      break;
+    }
     case ConstraintKind::Epigraph:
       name << "energy epigraph of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
       break;
@@ -419,6 +454,9 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
       lower[end] = upper[end] = scenario_.end[j];
     }
   }
+  // A closing joint follows the closure: its spline parameters are unused, fixed at the start posture.
+  for (int j = 0; closure_ && j < jointCount_; ++j)
+    if (closure_->closes(j)) lower.segment(j * m, m).setConstant(scenario_.start[j]), upper.segment(j * m, m).setConstant(scenario_.start[j]);
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
   lower.tail(variableCount_ - slackStart_).setZero();
 }
@@ -440,6 +478,17 @@ void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& up
         break;
       }
       case ConstraintKind::ContactUnilateral: lower[r] = scenario_.minimumNormalForce, upper[r] = kInf; break;
+      case ConstraintKind::ClosingJointLimit: {
+        const int k = row.detail % outputs_.closing, joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
+        if (row.detail < outputs_.closing) {
+          const JointLimits& limit = scenario_.robot.joints[static_cast<std::size_t>(joint)].limits;
+          lower[r] = limit.lower, upper[r] = limit.upper;
+        } else {
+          const double limit = scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit;
+          lower[r] = -limit, upper[r] = limit;
+        }
+        break;
+      }
       case ConstraintKind::InnerFeasibility: lower[r] = -kInf, upper[r] = 0.0; break;
       case ConstraintKind::ContactFriction:
       case ConstraintKind::ContactCop:
@@ -465,6 +514,9 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
                                 std::to_string(parameterCount_));
   Eigen::VectorXd x = Eigen::VectorXd::Zero(variableCount_);
   x.head(parameterCount_) = motionParameters;
+  const int m = parametrization_.parametersPerJoint();
+  for (int j = 0; closure_ && j < jointCount_; ++j)
+    if (closure_->closes(j)) x.segment(j * m, m).setConstant(scenario_.start[j]);  // unused (variableBounds)
   if (durationIsFree()) x[parameterCount_] = T;
   if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
@@ -479,6 +531,7 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
       for (int i = 0; i < outputs_.contacts; ++i)
         if (contactActive(i, s)) which.push_back(i);
       samples_.evaluate(s, controlPoints, duration(x), w.q, w.v, w.a);
+      if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr);
       inverseDynamics(modelOf(s), w.data, w.q, w.v, w.a);
       auto sample =
           std::make_unique<BilevelSample>(modelOf(s), surfacesInContact(s), scenario_.inner, scenario_.sensitivity, weight_);
@@ -547,13 +600,101 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
   return y;
 }
 
+bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const {
+  if (!closure_) return true;
+  // Newton from the angles reached last at this instant: the same closure, in one or two steps.
+  for (int k = 0; k < outputs_.closing; ++k)
+    if (std::isfinite(b.closedAngles[k])) w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]] = b.closedAngles[k];
+  return closure_->close(model_, w.closure, w.q, w.v, w.a, map);
+}
+
+void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
+                                Eigen::MatrixXd& da) const {
+  // ∂y/∂x_F = ∂y/∂x_F|_C fixed + ∂y/∂x_C M, x = (q, q̇, q̈); the closing joints' own columns then read zero.
+  const int c = outputs_.closing, n = jointCount_;
+  const std::vector<int>& closing = closure_->closingJoints();
+  for (int k = 0; k < c; ++k) {
+    const int j = closing[static_cast<std::size_t>(k)];
+    gather.col(k) = b.dyDq.col(j), gather.col(c + k) = b.dyDv.col(j), gather.col(2 * c + k) = b.dyDa.col(j);
+  }
+  dq = b.dyDq, dv = b.dyDv, da = b.dyDa;
+  dq.noalias() += gather * b.closureMap.leftCols(n);
+  dv.noalias() += gather * b.closureMap.middleCols(n, n);
+  da.noalias() += gather * b.closureMap.rightCols(n);
+  for (const int j : closing) dq.col(j).setZero(), dv.col(j).setZero(), da.col(j).setZero();
+}
+
+void MotionProblem::foldGradient(const Eigen::MatrixXd& map, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const {
+  const int c = outputs_.closing, n = jointCount_;
+  const std::vector<int>& closing = closure_->closingJoints();
+  for (int block = 0; block < stateBlocks; ++block)
+    for (int k = 0; k < c; ++k) {
+      const int at = block * n + closing[static_cast<std::size_t>(k)];
+      const double g = gradient[at];
+      gradient[at] = 0.0;
+      if (g != 0.0) gradient.head(stateBlocks * n) += g * map.row(block * c + k).head(stateBlocks * n).transpose();
+    }
+}
+
 void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
   samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+  if (closure_ && closeState(b, w, derivatives ? &b.closureMap : nullptr))
+    for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
   sampleOutputs(s, x, derivatives, w, b);
   if (!derivatives) return;
-  samples_.chainRule(s, T, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
+  if (closure_) {
+    foldClosure(b, w.gather, w.foldQ, w.foldV, w.foldA);
+    samples_.chainRule(s, T, w.foldQ, w.foldV, w.foldA, b.dyDx, b.parameters);
+  } else {
+    samples_.chainRule(s, T, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
+  }
+  // The closing joints' state scales with T as the splines' (it is theirs through the closure).
   SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
+}
+
+Eigen::MatrixXd MotionProblem::closureAngles() const {
+  Eigen::MatrixXd angles(outputs_.closing, static_cast<Eigen::Index>(blocks_.size()));
+  for (std::size_t s = 0; s < blocks_.size() && outputs_.closing > 0; ++s) angles.col(static_cast<Eigen::Index>(s)) = blocks_[s].closedAngles;
+  return angles;
+}
+
+void MotionProblem::startClosureAt(const Eigen::MatrixXd& angles) {
+  if (!closure_ || angles.rows() != outputs_.closing || angles.cols() != static_cast<Eigen::Index>(blocks_.size())) return;
+  for (std::size_t s = 0; s < blocks_.size(); ++s) blocks_[s].closedAngles = angles.col(static_cast<Eigen::Index>(s));
+  cacheValid_ = false;
+}
+
+Eigen::VectorXd MotionProblem::reportedMotionParameters(const Eigen::VectorXd& x) {
+  Eigen::VectorXd parameters = motionParameters(x);
+  if (!closure_) return parameters;
+  evaluate(x, false);
+  const int N = samples_.sampleCount(), m = parametrization_.parametersPerJoint();
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(N, m);
+  for (int s = 0; s < N; ++s) {
+    const LocalParameterWeights& local = samples_.weights(s);
+    for (int l = 0; l < local.count; ++l) basis(s, local.parameter[static_cast<std::size_t>(l)]) += local.value[static_cast<std::size_t>(l)];
+  }
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(basis);
+  Eigen::VectorXd angles(N);
+  for (int k = 0; k < outputs_.closing; ++k) {
+    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+    for (int s = 0; s < N; ++s) angles[s] = blocks_[static_cast<std::size_t>(s)].y[outputs_.closingPosition(k)];
+    parameters.segment(j * m, m) = qr.solve(angles);
+  }
+  return parameters;
+}
+
+void MotionProblem::stateAt(const Eigen::VectorXd& x, double u, Eigen::VectorXd& q, Eigen::VectorXd& v,
+                            Eigen::VectorXd& a) const {
+  const SampledTrajectory at(parametrization_, std::vector<double>{u});
+  Eigen::MatrixXd controlPoints;
+  parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
+  q.resize(jointCount_), v.resize(jointCount_), a.resize(jointCount_);
+  at.evaluate(0, controlPoints, duration(x), q, v, a);
+  if (!closure_) return;
+  ClosedChainData d(model_, closure_->contactCount());
+  closure_->close(model_, d, q, v, a, nullptr);
 }
 
 void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w,
@@ -663,14 +804,36 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
     b.dyDa(row, j) += p.dAcceleration;
     if (b.dyDz.cols() > 0) b.dyDz.row(row) = p.dTorque * b.dyDz.row(outputs_.torque(j));
   }
+  // The closing joints' angles and velocities, for their limits (their derivatives in the
+  // full state: unit rows, folded through the closure by the caller).
+  for (int k = 0; k < outputs_.closing; ++k) {
+    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+    b.y[outputs_.closingPosition(k)] = w.q[j];
+    b.y[outputs_.closingVelocity(k)] = w.v[j];
+    if (!derivatives) continue;
+    for (const int row : {outputs_.closingPosition(k), outputs_.closingVelocity(k)}) {
+      b.dyDq.row(row).setZero(), b.dyDv.row(row).setZero(), b.dyDa.row(row).setZero();
+      if (b.dyDz.cols() > 0) b.dyDz.row(row).setZero();
+    }
+    b.dyDq(outputs_.closingPosition(k), j) = 1.0;
+    b.dyDv(outputs_.closingVelocity(k), j) = 1.0;
+  }
 }
 
 void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
   taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+  if (closure_ && closeState(b, w, derivatives ? &b.closureMap : nullptr))
+    for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
   taskOutputs(i, derivatives, w, b);
   if (!derivatives) return;
-  taskSamples_.chainRule(i, T, b.dyDq, b.dyDv, Eigen::MatrixXd(), b.dyDx, b.parameters);
+  if (closure_) {
+    // Tasks read q and q̇; the closure's q_C and q̇_C depend on no q̈.
+    foldClosure(b, w.taskGather, w.taskFoldQ, w.taskFoldV, w.taskFoldA);
+    taskSamples_.chainRule(i, T, w.taskFoldQ, w.taskFoldV, Eigen::MatrixXd(), b.dyDx, b.parameters);
+  } else {
+    taskSamples_.chainRule(i, T, b.dyDq, b.dyDv, Eigen::MatrixXd(), b.dyDx, b.parameters);
+  }
   SampledTrajectory::durationDerivative(T, b.dyDv, b.dyDa, w.v, w.a, b.dyDT);
 }
 
@@ -735,7 +898,9 @@ double MotionProblem::objective(const Eigen::VectorXd& x) {
       for (int j = 0; j < n; ++j)
         sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)], scenario_.smoothing);
     if (scenario_.accelerationWeight > 0.0)
-      sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration.squaredNorm();
+      for (int j = 0; j < n; ++j)  // the spline joints' (a closing joint's follows the closure)
+        if (!closure_ || !closure_->closes(j))
+          sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration[j] * blocks_[static_cast<std::size_t>(s)].acceleration[j];
     energy += weight * sum;
   }
   return energy;
@@ -759,10 +924,14 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
       const LocalParameterWeights& local = samples_.weights(s);
       const double scale = weight * scenario_.accelerationWeight;
       const int m = parametrization_.parametersPerJoint();
-      for (int j = 0; j < n; ++j)
+      double squared = 0.0;
+      for (int j = 0; j < n; ++j) {
+        if (closure_ && closure_->closes(j)) continue;
+        squared += b.acceleration[j] * b.acceleration[j];
         for (int l = 0; l < local.count; ++l)
           gradient[j * m + local.parameter[l]] += scale * 2.0 * b.acceleration[j] * local.d2[l] / (T * T);
-      dT += scale * (b.acceleration.squaredNorm() / T - 4.0 * b.acceleration.squaredNorm() / T);
+      }
+      dT += scale * (squared / T - 4.0 * squared / T);
     }
     if (epigraph) {
       gradient.segment(slackIndex(s, 0), n).array() += weight;
@@ -858,6 +1027,10 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
   Eigen::VectorXd q(jointCount_), v(jointCount_), a(jointCount_);
   atRelease.evaluate(0, controlPoints, T, q, v, a);
+  if (closure_) {
+    ClosedChainData closing(model_, closure_->contactCount());
+    closure_->close(model_, closing, q, v, a, nullptr);
+  }
   DynamicsData data(model_);
   inverseDynamics(model_, data, q, v, a);  // the bodies' poses and twists
   const RigidTransform pose = framePose(model_, data, ball.frame);
@@ -899,7 +1072,9 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   for (int s = 0; s < N; ++s) {
     const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
     p.time[s] = samples_.time(s, T);
-    samples_.evaluate(s, controlPoints_, T, p.q.col(s), p.v.col(s), p.a.col(s));
+    samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+    closeState(b, w, nullptr);
+    p.q.col(s) = w.q, p.v.col(s) = w.v, p.a.col(s) = w.a;
     inverseDynamics(modelOf(s), w.data, p.q.col(s), p.v.col(s), p.a.col(s));
     p.tau0.col(s) = w.data.tau;
     p.referenceWrench.col(s) = referenceWrenchAtReferenceFrame(modelOf(s), w.data);
@@ -935,9 +1110,15 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   const SampledTrajectory fine(parametrization_, std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1));
   for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
     drift->assign(static_cast<std::size_t>(contacts), 0.0);
+  Eigen::VectorXd previousAngles = closure_ ? Eigen::VectorXd(blocks_.front().closedAngles) : Eigen::VectorXd();
   for (int s = 0; s < fine.sampleCount(); ++s) {
     const double u = static_cast<double>(s) / (fine.sampleCount() - 1);
     fine.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
+    if (closure_) {  // Newton from the previous fine instant's closing angles (the first: the first sample's)
+      for (int k = 0; k < outputs_.closing; ++k) w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]] = previousAngles[k];
+      closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr);
+      for (int k = 0; k < outputs_.closing; ++k) previousAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+    }
     inverseDynamics(model_, w.data, w.q, w.v, w.a);  // the poses and the twists
     for (int i = 0; i < contacts; ++i) {
       if (!insideWindow(u, windows_[static_cast<std::size_t>(i)])) continue;

@@ -28,8 +28,14 @@
 //      (μ² f_z² − f_x² − f_y²)/(m g)² ≥ 0, the centre of pressure in the rectangle written
 //      linearly; bilevel: the inner problem's infeasibility φ = ‖slack‖²/(m g)² ≤ 0 (the
 //      inner problem holds the contacts' own rows); with the epigraph form s_js − P_js ≥ 0;
-//   3. task rows: per task, per instant, per bounded component; a contact's closure (its
-//      frame at its world pose over its window) is a pair of such tasks.
+//   3. task rows: per task, per instant, per bounded component; a contact's closure over a
+//      window (its frame at its world pose there) is a pair of such tasks;
+//   4. per sample, the position and velocity limits of the joints that close a contact held
+//      over the whole motion (closed_chains.hpp): those joints follow the closure, not splines.
+// A contact held over the whole motion holds by construction: at every instant its loop's six
+// closing joints are the closure's (closed_chains.hpp), and every output's derivative goes
+// through them (the chain rule by the implicit function theorem); their spline parameters are
+// fixed at the start posture and unused.
 // Sample rows depend only on the ≤ 4 local parameters of the joints that move them (+ T,
 // + the sample's force variables, + a slack), which is the declared sparsity.
 //
@@ -48,6 +54,7 @@
 #include "core/bspline.hpp"
 #include "core/dynamics_derivatives.hpp"
 #include "core/dynamics_model.hpp"
+#include "outer_nlp/closed_chains.hpp"
 #include "outer_nlp/contact_force_parametrization.hpp"
 #include "outer_nlp/derivative_stencil.hpp"
 #include "outer_nlp/nlp_problem.hpp"
@@ -59,9 +66,9 @@ namespace mcopt {
 
 enum class ConstraintKind {
   VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, ContactYaw, InnerFeasibility, Closure, Task,
-  Epigraph
+  Epigraph, ClosingJointLimit
 };
-inline constexpr int kConstraintKindCount = 10;
+inline constexpr int kConstraintKindCount = 11;
 const char* constraintKindName(ConstraintKind kind);
 
 class BilevelSample;
@@ -149,6 +156,11 @@ class MotionProblem final : public NlpProblem {
   int infeasibleSamples() const { return innerStatistics().infeasible; }
   /// Whether environment contact i (scenario.contacts order) is in contact at sample s.
   bool contactActive(int contact, int sample) const;
+  /// The contacts held over the whole motion by construction, and their closing joints (null:
+  /// none, every contact has a window).
+  const ClosedChains* closedChains() const { return closure_.get(); }
+  /// The motion's state at normalised time u: the splines', the closing joints' from the closure.
+  void stateAt(const Eigen::VectorXd& x, double u, Eigen::VectorXd& q, Eigen::VectorXd& v, Eigen::VectorXd& a) const;
 
   int variableCount() const override { return variableCount_; }
   int nonlinearVariableCount() const override { return slackStart_; }
@@ -174,8 +186,15 @@ class MotionProblem final : public NlpProblem {
   /// The same from `other`'s point x (another continuation stage's problem, whose energy form
   /// or formulation may lay out other variables after the shared spline parameters and T).
   Eigen::VectorXd pointFrom(const MotionProblem& other, const Eigen::VectorXd& x) {
+    startClosureAt(other.closureAngles());
     return pointFromMotion(other.motionParameters(x), other.duration(x));
   }
+  /// The closing joints' angles the closure reached last at each sample (closing joints × samples;
+  /// empty without closed chains), and a start for the closure's Newton at each sample from such
+  /// angles (another stage or round of the same scenario: the same grid and closing joints;
+  /// anything else is ignored). Newton then stays on the branch of the motion it continues.
+  Eigen::MatrixXd closureAngles() const;
+  void startClosureAt(const Eigen::MatrixXd& angles);
   /// `other`'s point x (the same scenario on another grid of samples: energy_balance.hpp) as a
   /// point of this problem with the same motion and the same contact wrenches: the force
   /// splines copied (their windows and control points do not depend on the grid); the
@@ -183,6 +202,10 @@ class MotionProblem final : public NlpProblem {
   /// in time (within the ball's carried and released parts apart); slacks at max(P, 0).
   Eigen::VectorXd pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x);
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
+  /// x's spline parameters, with each closing joint's (unused: closed_chains.hpp) replaced by a
+  /// least-squares fit of its motion at the samples — what a result reports, so that its
+  /// parameters describe every joint and can start a problem rooted elsewhere (--start-from).
+  Eigen::VectorXd reportedMotionParameters(const Eigen::VectorXd& x);
   double duration(const Eigen::VectorXd& x) const {
     return durationIsFree() ? x[parameterCount_] : scenario_.duration.initial;
   }
@@ -225,7 +248,10 @@ class MotionProblem final : public NlpProblem {
     int contactRow(int contact, int c) const { return joints + rowsPerContact * (1 + contact) + c; }
     int infeasibility() const { return joints + rowsPerContact * (1 + contacts); }
     int power(int j) const { return infeasibility() + 1 + j; }
-    int size() const { return power(joints); }
+    int closing = 0;  ///< joints that close a contact held over the whole motion
+    int closingPosition(int k) const { return power(joints) + k; }
+    int closingVelocity(int k) const { return power(joints) + closing + k; }
+    int size() const { return power(joints) + 2 * closing; }
   };
 
  private:
@@ -248,6 +274,10 @@ class MotionProblem final : public NlpProblem {
       int firstColumn;
     };
     std::vector<ForceTerm> forceTerms;
+    /// With closed chains: ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) at this instant (closed_chains.hpp),
+    /// and the closing joints' angles reached last (the next Newton start; NaN: none yet).
+    Eigen::MatrixXd closureMap;
+    Eigen::VectorXd closedAngles;
   };
   using ThreadWorkspace = MotionWorkspace;
   /// A row of the registry: its kind, what `detail` says (joint, contact row, task
@@ -273,6 +303,16 @@ class MotionProblem final : public NlpProblem {
   /// A task instant's outputs at the state in w.q, w.v (w.a for the dynamics' forward pass).
   void taskOutputs(int i, bool derivatives, ThreadWorkspace& w, SampleBlock& b);
   void buildStructure();
+  /// The closing joints' state in w.q, w.v, w.a from the others' (Newton from b's last angles),
+  /// with the map into `map` when given. False when the loop cannot close there.
+  bool closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const;
+  /// Chain rule through the closure: (dyDq, dyDv, dyDa) of b, the closing joints' columns
+  /// folded into the others' through b.closureMap, into dq, dv, da.
+  void foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
+                   Eigen::MatrixXd& da) const;
+  /// A gradient in the full state's first `stateBlocks` blocks (q; q, q̇; or q, q̇, q̈), brought
+  /// to the spline joints' through the closure's map: g_F += Mᵀ g_C, g_C = 0.
+  void foldGradient(const Eigen::MatrixXd& map, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
     Eigen::VectorXd probeX, weights, base, gradient;
@@ -290,6 +330,14 @@ class MotionProblem final : public NlpProblem {
     Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchJacobian, curvedWrenchJacobian;
     // A throw's task instant: the weights its flight puts on the ball's state (task_kinematics.hpp).
     Vector6 ballWeights = Vector6::Zero();
+    // Closed chains: the closing joints' columns and rows of H, and of the duration's row, set
+    // aside while the state Hessian is brought to the spline joints' (motion_hessian.cpp).
+    Eigen::MatrixXd foldColumns, foldRows;
+    Eigen::VectorXd foldDuration;
+    // Closed chains, sample differences: the closure's map at a probe, and the closed state the
+    // probes start from.
+    Eigen::MatrixXd probeMap;
+    Eigen::VectorXd closedState;
   };
   /// The exact option's stencils (derivative_stencil.hpp): along a joint angle, a velocity, an
   /// acceleration, a force variable of a sample, and a task instant's angle and velocity.
@@ -347,6 +395,7 @@ class MotionProblem final : public NlpProblem {
   bool bilevel_ = false;
   std::vector<std::array<double, 2>> windows_;   ///< per environment contact, normalised
   std::unique_ptr<ContactForceParametrization> forces_;
+  std::unique_ptr<ClosedChains> closure_;  ///< null without a contact held over the whole motion
   std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit

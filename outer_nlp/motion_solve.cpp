@@ -16,6 +16,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
   Eigen::VectorXd x = x0;
   const int stages = static_cast<int>(scenario.continuation.size()) + 1;
   std::optional<Scenario> solved;  // the problem of the last stage that ended optimal
+  Eigen::MatrixXd closureAngles;  // the closing joints' angles at each sample, handed from solve to solve
   for (int k = 0; k < stages; ++k) {
     const bool last = k + 1 == stages;
     const Scenario stageScenario = continuationStage(scenario, static_cast<std::size_t>(k));
@@ -31,6 +32,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     // parameters and T (the epigraph's slacks): it starts from the motion reached, its own
     // variables set from it (MotionProblem::pointFrom; the smooth maximum's optimum, then the
     // exact epigraph form: docs/theory/outer-problem.md, "Continuation").
+    full.startClosureAt(closureAngles);
     if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
     std::vector<bool> omitted;
     if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
@@ -44,6 +46,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     int joined = 0;
     for (;;) {
       MotionProblem current(stageScenario, omitted);
+      current.startClosureAt(closureAngles);  // the closure continues the motion's branch
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
       if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
       IpoptSettings roundSettings = settings;
@@ -92,6 +95,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
         return !events.onIteration || events.onIteration(k, current, r);
       });
+      closureAngles = current.closureAngles();
       ++stage.rounds;
       stage.iterations += outcome.iterations;
       stage.seconds += outcome.seconds;
@@ -131,6 +135,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       break;
     }
   }
+  problem.startClosureAt(closureAngles);  // the results' closure on the run's branch
   // The run's iterate in the scenario's own layout, also when an earlier stage's is the last usable one.
   if (result.solver.x.size() > 0 && result.solver.x.size() != problem.variableCount())
     result.solver.x = problem.pointFrom(problem, result.solver.x);

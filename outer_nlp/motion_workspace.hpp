@@ -10,6 +10,7 @@
 #include "core/dynamics_derivatives.hpp"
 #include "core/dynamics_model.hpp"
 #include "core/spatial.hpp"
+#include "outer_nlp/closed_chains.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
 #include "outer_nlp/task_kinematics.hpp"
 
@@ -17,8 +18,10 @@ namespace mcopt {
 
 /// MotionProblem's per-thread buffers, sized once (the per-sample path allocates nothing).
 struct MotionWorkspace {
-  MotionWorkspace(const DynamicsModel& model, int contacts, int rowsPerContact)
-      : data(model), derivatives(model), task(model) {
+  /// `held`: contacts held over the whole motion, `closing` their closing joints, `outputs` a
+  /// sample's outputs (the chain rule through the closure works on those).
+  MotionWorkspace(const DynamicsModel& model, int contacts, int rowsPerContact, int held = 0, int closing = 0, int outputs = 0)
+      : data(model), derivatives(model), task(model), closure(model, held) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
     torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
@@ -26,6 +29,8 @@ struct MotionWorkspace {
     toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
     rowsByWrench.assign(static_cast<std::size_t>(contacts), ContactRowsByWrench::Zero(rowsPerContact, 6));
     rowsByReference.setZero(rowsPerContact, 6);
+    gather.setZero(outputs, 3 * closing), foldQ.setZero(outputs, n), foldV.setZero(outputs, n), foldA.setZero(outputs, n);
+    taskGather.setZero(3, 3 * closing), taskFoldQ.setZero(3, n), taskFoldV.setZero(3, n), taskFoldA.setZero(3, n);
   }
   DynamicsData data;
   DynamicsDerivatives derivatives;
@@ -37,6 +42,9 @@ struct MotionWorkspace {
   std::vector<Matrix6> toWorld;          ///< per environment contact, wrenchToWorld_i
   std::vector<ContactRowsByWrench> rowsByWrench;  ///< per environment contact, ∂rows_i/∂F_i
   ContactRowsByWrench rowsByReference;           ///< ∂rows_ref/∂W_ref
+  ClosedChainData closure;                       ///< the closure's Newton and its map
+  Eigen::MatrixXd gather, foldQ, foldV, foldA;   ///< a sample's outputs folded through the closure
+  Eigen::MatrixXd taskGather, taskFoldQ, taskFoldV, taskFoldA;  ///< a task instant's
 };
 
 }  // namespace mcopt

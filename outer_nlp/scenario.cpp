@@ -193,6 +193,7 @@ void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
   position.name = "closure of " + c.surface.name + " (position)";
   position.origin = c.origin;
   position.closure = true;
+  position.heldThroughout = !c.window;
   position.kind = TaskKind::Position;
   position.body = s.robot.frames[static_cast<std::size_t>(c.surface.frame)].name;
   position.frame = c.surface.frame;
@@ -374,6 +375,12 @@ std::string exactHessianRefusal(const Scenario& s) {
   if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
     return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
            "variables, or hessian: sample-differences";
+  for (const EnvironmentContact& c : s.contacts)
+    if (!c.window)
+      return "contact '" + c.surface.name + "' is held over the whole motion by construction, its loop's closing joints "
+             "following the others (docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no "
+             "rule for that map; use hessian: sample-differences or gauss-newton, or give the contact a window over the "
+             "whole motion to hold it by a band";
   for (const Joint& joint : s.robot.joints)
     if (joint.type == JointType::Prismatic)
       return "prismatic joint '" + joint.name + "': its stencil assumes revolute joints";

@@ -720,8 +720,12 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
 
 TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages and refuses what exact cannot do", "[cli][run]") {
   const test::TempDir dir;
-  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir,
-                                           [](YAML::Node& root) { root["samples"] = 12; }, "weight_shift.yaml");
+  // The right sole held by a band (a window over the whole motion): the exact option's stencils
+  // have no rule for the closure of a contact held by construction (refused below).
+  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+    root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 2.4]}]");
+  }, "weight_shift.yaml");
   // The bundled scenario: a gauss-newton stage, then sample-differences. With --hessian exact
   // and wrenches as variables one stage is left, and it runs with the exact Hessian.
   const auto out = dir.path() / "exact";
@@ -757,6 +761,12 @@ TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages
                                       test::quoted(dir.path() / "never"));
   CHECK(refused.exitCode == 2);
   CHECK_THAT(refused.errors, Contains("--hessian: exact: ") && Contains("bilevel"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "never"));
+  // The bundled right sole, held by construction: refused whatever the formulation.
+  const auto held = test::runMcopt("run " + test::quoted(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml") +
+                                   " --contact-forces variables --hessian exact --out " + test::quoted(dir.path() / "never"));
+  CHECK(held.exitCode == 2);
+  CHECK_THAT(held.errors, Contains("--hessian: exact: ") && Contains("contact 'r_sole' is held over the whole motion"));
   CHECK_FALSE(std::filesystem::exists(dir.path() / "never"));
   const auto unknown = test::runMcopt("run " + test::quoted(weightShift) + " --hessian newton");
   CHECK(unknown.exitCode != 0);

@@ -106,9 +106,10 @@ TEST_CASE("energy balance: the identity fails on a wrench or a state the torques
     CHECK(std::abs(perturbed.mechanicalResidual()) > 10.0 * tolerance);
   }
   SECTION("a spline parameter perturbed under the same torques") {
-    // One inner control point of the right knee (a joint that carries the body).
+    // One inner control point of the left knee (a joint that carries the body; the right leg's
+    // follow the closure of the right sole, their splines unused).
     const int m = fine.parametrization().parametersPerJoint();
-    const int knee = scenario.robot.jointIndex("RLEG_JOINT3");
+    const int knee = scenario.robot.jointIndex("LLEG_JOINT3");
     REQUIRE(knee >= 0);
     Eigen::VectorXd z = y;
     z[knee * m + m / 2] += 0.05;

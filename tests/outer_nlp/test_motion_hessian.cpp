@@ -324,7 +324,13 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
     const double duration = s.duration.initial;
     if (c.freeDuration) s.duration.lower = 0.8 * duration, s.duration.upper = 1.3 * duration;
     if (c.everyTask) s.tasks = test::everyTaskKind(s);
+    // The option covers contacts held by the band, over windows: a contact held throughout is
+    // closed by construction, whose map has no stencil (refused: test_closed_chains.cpp). The
+    // soles here are given the whole motion as an explicit window, as a scenario file would.
+    for (EnvironmentContact& contact : s.contacts) contact.window = true;
+    for (TaskSpec& t : s.tasks) t.heldThroughout = false;
     MotionProblem problem(s);
+    REQUIRE(problem.closedChains() == nullptr);
     Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 23);
     if (c.freeDuration) x[problem.parametrization().parameterCount()] = 1.1 * duration;
     const double error = exactHessianError(problem, x, randomMultipliers(problem, 29), 0.8);
@@ -342,24 +348,32 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   lean.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(lean), Catch::Matchers::Contains("hessian: exact: the bilevel formulation"));
   // In the file and in a continuation stage (the bundled throw is bilevel on two soles):
-  // file:line: field: why.
+  // file:line: field: why. Its right sole is held by a band here (a window over the whole
+  // motion): held by construction, it is refused whatever the formulation (below).
   const test::TempDir dir;
+  const auto banded = [](YAML::Node& root) { root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 2.0]}]"); };
   const std::filesystem::path throwFile = test::scenarioVariant(
-      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir, [](YAML::Node& root) { root["hessian"] = "exact"; },
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir, [&](YAML::Node& root) { banded(root), root["hessian"] = "exact"; },
       "throw.yaml");
   CHECK_THROWS_WITH(loadScenario(throwFile), Catch::Matchers::Contains(throwFile.string() + ":") &&
                                                  Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   const std::filesystem::path stageFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact}]"); }, "stage.yaml");
+      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact}]"); }, "stage.yaml");
   CHECK_THROWS_WITH(loadScenario(stageFile),
                     Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));
   // With the wrenches as spline parameters the same throw is accepted: its flight has an exact
   // Hessian (task_kinematics.hpp).
   const std::filesystem::path splinesFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
+      [&](YAML::Node& root) { banded(root), root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
   CHECK_NOTHROW(loadScenario(splinesFile));
+  // The bundled right sole, held by construction: refused with the file's line, as splines too.
+  const std::filesystem::path heldFile = test::scenarioVariant(
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
+      [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "held.yaml");
+  CHECK_THROWS_WITH(loadScenario(heldFile), Catch::Matchers::Contains(heldFile.string() + ":") &&
+                                                Catch::Matchers::Contains("contact 'r_sole' is held over the whole motion"));
   // The formulation a run chooses (`mcopt run --contact-forces`) is the one checked.
   CHECK_NOTHROW(loadScenario(throwFile, ContactForces::Splines));
   CHECK_THROWS_WITH(loadScenario(splinesFile, ContactForces::Bilevel),
@@ -369,12 +383,12 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   // for bilevel.
   const std::filesystem::path otherFormulation = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [splines]}]"); },
+      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [splines]}]"); },
       "other.yaml");
   CHECK_NOTHROW(loadScenario(otherFormulation));
   const std::filesystem::path bilevelStage = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [bilevel]}]"); },
+      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [bilevel]}]"); },
       "bilevel.yaml");
   CHECK_THROWS_WITH(loadScenario(bilevelStage),
                     Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));

@@ -15,8 +15,11 @@ def test_compare_inner_solvers(tmp_path):
     rows = {m.group(1): m.groups()[1:] for m in re.finditer(r"^(active-set|slsqp|ipopt)\s+(\d+)\s+(\d+)\s+\S+\s+\S+\s+(\S+)$",
                                                            done.stdout, re.M)}
     assert set(rows) == {"active-set", "slsqp", "ipopt"}, done.stdout
+    # The three solvers agree on every sample's status (after 5 iterations the weight shift's
+    # motion has a few samples whose inner problem is infeasible: the robot would tip there).
+    assert len({(optimal, other) for optimal, other, _ in rows.values()}) == 1, done.stdout
     for name, (optimal, other, gap) in rows.items():
-        assert int(optimal) == 20 and int(other) == 0, (name, done.stdout)
+        assert int(optimal) + int(other) == 20 and int(optimal) >= 10, (name, done.stdout)
         # Every solver reaches the active-set method's optimum.
         assert float(gap) < 1e-8, (name, gap)
     for suffix in ("png", "svg"):

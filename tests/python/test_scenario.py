@@ -117,6 +117,9 @@ def test_the_chosen_formulation_is_the_one_the_files_checks_see(mcopt_exe, tmp_p
     again when run as bilevel, with the CLI's message."""
     s = mcopt.Scenario(THROW, contact_forces="splines")
     assert s.contact_forces == "splines" and s["contact_forces"] == "bilevel"  # a choice, not a field
+    # The right sole held by a band (a window over the whole motion): held by construction, the
+    # exact option is refused whatever the formulation.
+    s["contacts"] = ["l_sole", {"surface": "r_sole", "window": [0.0, s["duration"]]}]
     s["hessian"] = "exact"  # checked for splines: accepted
     s.save(tmp_path / "exact.yaml")
     message = cli_error(mcopt_exe, "run", tmp_path / "exact.yaml", "--out", tmp_path / "o")

@@ -1,0 +1,229 @@
+// SPDX-License-Identifier: BSD-3-Clause
+#include "outer_nlp/closed_chains.hpp"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/errors.hpp"
+#include "core/inverse_dynamics.hpp"
+
+namespace mcopt {
+namespace {
+
+constexpr int kNewtonIterations = 50;
+/// Newton's method runs to the rounding floor — the closure's value must be smooth to well
+/// below what a difference quotient of the outer problem resolves —: converged below 1e-14
+/// [m, rad], or below 1e-9 once a step no longer halves the residual.
+constexpr double kPoseTolerance = 1e-14, kPoseFloor = 1e-9;
+
+}  // namespace
+
+ClosedChainData::ClosedChainData(const DynamicsModel& model, int contacts)
+    : data(model), lu(6 * contacts) {
+  const int n = model.jointCount(), rows = 6 * contacts;
+  jacobian.setZero(6, n);
+  for (MotionDerivative* m : {&twistDq, &twistDv, &accelerationDq, &accelerationDv, &accelerationDa}) m->setZero(6, n);
+  for (Eigen::MatrixXd* m : {&spatial, &twistByAngle, &accelerationByAngle, &accelerationByVelocity}) m->setZero(rows, n);
+  closing.setZero(rows, rows);
+  residual.setZero(rows), step.setZero(rows), zeroAcceleration.setZero(n);
+  rhs.setZero(rows, 3 * n);
+}
+
+ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> contacts, const Eigen::VectorXd& posture)
+    : contacts_(std::move(contacts)), posture_(posture) {
+  const int n = model.jointCount();
+  closes_.assign(static_cast<std::size_t>(n), false);
+  contactOf_.assign(static_cast<std::size_t>(n), -1);
+  for (std::size_t i = 0; i < contacts_.size(); ++i) {
+    const HeldContact& c = contacts_[i];
+    const int body = model.framePosition(c.frame);
+    std::vector<int> path;
+    for (int j = 0; j < n; ++j)
+      if (model.supports(j, body) && !closes_[static_cast<std::size_t>(j)]) path.push_back(j);
+    // The joints nearest the contact's body first (deepest in the tree rooted at the reference body).
+    std::sort(path.begin(), path.end(), [&](int a, int b) { return model.positionOfJoint(a) > model.positionOfJoint(b); });
+    if (path.size() < 6)
+      throw InputError("contact '" + c.name + "': its loop through the reference body has " + std::to_string(path.size()) +
+                       " joints free to close it; holding it takes six");
+    for (int k = 0; k < 6; ++k) {
+      closing_.push_back(path[static_cast<std::size_t>(k)]);
+      closes_[static_cast<std::size_t>(path[static_cast<std::size_t>(k)])] = true;
+      contactOf_[static_cast<std::size_t>(path[static_cast<std::size_t>(k)])] = static_cast<int>(i);
+    }
+  }
+  if (contacts_.empty()) return;
+  // The six joints must move the frame in every direction at the start posture.
+  ClosedChainData d(model, contactCount());
+  forwardKinematics(model, d.data, posture);
+  for (int i = 0; i < contactCount(); ++i) {
+    const HeldContact& c = contacts_[static_cast<std::size_t>(i)];
+    const RigidTransform pose = framePose(model, d.data, c.frame) * c.placement;
+    frameJacobian(model, d.data, model.framePosition(c.frame), pose.translation, d.jacobian);
+    Eigen::Matrix<double, 6, 6> J;
+    for (int k = 0; k < 6; ++k) J.col(k) = d.jacobian.col(closing_[static_cast<std::size_t>(6 * i + k)]);
+    const Eigen::JacobiSVD<Eigen::Matrix<double, 6, 6>> svd(J);
+    const double ratio = svd.singularValues()(5) / svd.singularValues()(0);
+    if (!(ratio > 1e-6)) {
+      std::string names;
+      for (int k = 0; k < 6; ++k)
+        names += (k ? ", " : "") + model.robot().joints[static_cast<std::size_t>(closing_[static_cast<std::size_t>(6 * i + k)])].name;
+      throw InputError("contact '" + c.name + "': its closing joints (" + names +
+                       ") cannot move its frame in every direction at the start posture (singular)");
+    }
+  }
+}
+
+void ClosedChains::poseResidual(const DynamicsModel& model, ClosedChainData& d) const {
+  for (int i = 0; i < contactCount(); ++i) {
+    const HeldContact& c = contacts_[static_cast<std::size_t>(i)];
+    const RigidTransform pose = framePose(model, d.data, c.frame) * c.placement;
+    d.residual.segment<3>(6 * i) = pose.translation - c.worldPose.translation;
+    const Eigen::AngleAxisd error(Matrix3(pose.rotation * c.worldPose.rotation.transpose()));
+    d.residual.segment<3>(6 * i + 3) = error.angle() * error.axis();
+  }
+}
+
+std::pair<double, double> ClosedChains::poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q) const {
+  forwardKinematics(model, d.data, q);
+  poseResidual(model, d);
+  double distance = 0.0, angle = 0.0;
+  for (int i = 0; i < contactCount(); ++i)
+    distance = std::max(distance, d.residual.segment<3>(6 * i).norm()), angle = std::max(angle, d.residual.segment<3>(6 * i + 3).norm());
+  return {distance, angle};
+}
+
+bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q,
+                         Eigen::Ref<Eigen::VectorXd> v, Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map) const {
+  if (empty()) return true;
+  const int c = closingCount(), n = model.jointCount();
+  // The closing joints' point-form Jacobian columns at the pose in d.data: (linear velocity of
+  // the frame origin, angular velocity), world axes — e's derivative at e = 0.
+  auto closingJacobian = [&](bool full) {
+    for (int i = 0; i < contactCount(); ++i) {
+      const HeldContact& contact = contacts_[static_cast<std::size_t>(i)];
+      const RigidTransform pose = framePose(model, d.data, contact.frame) * contact.placement;
+      frameJacobian(model, d.data, model.framePosition(contact.frame), pose.translation, d.jacobian);
+      for (int k = 0; k < c; ++k) d.closing.block<6, 1>(6 * i, k) = d.jacobian.col(closing_[static_cast<std::size_t>(k)]);
+      if (full) d.spatial.middleRows<6>(6 * i) = d.jacobian;
+    }
+  };
+  // Newton's method on the pose, its step halved while it does not reduce the residual (far
+  // from the closure, a full step may overshoot); from q's closing angles, then, if that fails,
+  // from the start posture's.
+  auto newton = [&]() {
+    double previous = std::numeric_limits<double>::infinity();
+    forwardKinematics(model, d.data, q);
+    poseResidual(model, d);
+    for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
+      if (!d.residual.allFinite()) return false;
+      const double size = d.residual.lpNorm<Eigen::Infinity>();
+      if (size < kPoseTolerance || (size < kPoseFloor && size > 0.5 * previous)) return true;
+      previous = size;
+      closingJacobian(false);
+      d.lu.compute(d.closing);
+      d.step.noalias() = d.lu.solve(d.residual);
+      double scale = 1.0;
+      for (int halving = 0; halving < 12; ++halving, scale *= 0.5) {
+        for (int k = 0; k < c; ++k) q[closing_[static_cast<std::size_t>(k)]] -= scale * d.step[k];
+        forwardKinematics(model, d.data, q);
+        poseResidual(model, d);
+        if (d.residual.allFinite() && (d.residual.lpNorm<Eigen::Infinity>() < size || size < kPoseFloor)) break;
+        for (int k = 0; k < c; ++k) q[closing_[static_cast<std::size_t>(k)]] += scale * d.step[k];
+        if (halving == 11) {  // no decrease along the step: leave the residual of q as it is
+          forwardKinematics(model, d.data, q);
+          poseResidual(model, d);
+          return d.residual.lpNorm<Eigen::Infinity>() < kPoseFloor;
+        }
+      }
+    }
+    return false;
+  };
+  bool converged = newton();
+  if (!converged) {
+    for (const int j : closing_) q[j] = posture_[j];
+    converged = newton();
+  }
+  if (!converged) {
+    for (const int j : closing_) q[j] = v[j] = a[j] = std::numeric_limits<double>::quiet_NaN();
+    if (map) map->setConstant(std::numeric_limits<double>::quiet_NaN());
+    return false;
+  }
+  // Velocities: J (q̇ with q̇_C = 0) + J_C q̇_C = 0.
+  closingJacobian(true);
+  for (const int j : closing_) v[j] = 0.0;
+  d.residual.noalias() = d.spatial * v;
+  d.lu.compute(d.closing);
+  d.step.noalias() = d.lu.solve(d.residual);
+  for (int k = 0; k < c; ++k) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
+  // Accelerations: the spatial acceleration with q̈_C = 0, against the fixed world's (the
+  // reference body's, gravity folded in), then S_C q̈_C cancels the difference. S is the frame
+  // Jacobian about the world origin.
+  for (const int j : closing_) a[j] = 0.0;
+  inverseDynamics(model, d.data, q, v, a);
+  for (int i = 0; i < contactCount(); ++i) {
+    const int body = model.framePosition(contacts_[static_cast<std::size_t>(i)].frame);
+    d.residual.segment<3>(6 * i) = d.data.linearAcceleration[static_cast<std::size_t>(body)] - d.data.linearAcceleration[0];
+    d.residual.segment<3>(6 * i + 3) = d.data.angularAcceleration[static_cast<std::size_t>(body)] - d.data.angularAcceleration[0];
+    frameJacobian(model, d.data, body, Vector3::Zero(), d.jacobian);
+    d.spatial.middleRows<6>(6 * i) = d.jacobian;
+  }
+  for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
+  d.lu.compute(d.closing);
+  d.step.noalias() = d.lu.solve(d.residual);
+  for (int k = 0; k < c; ++k) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
+  if (!map) return true;
+
+  // ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) by the implicit function theorem, at the closed state.
+  inverseDynamics(model, d.data, q, v, a);
+  for (int i = 0; i < contactCount(); ++i) {
+    bodyMotionDerivatives(model, d.data, model.framePosition(contacts_[static_cast<std::size_t>(i)].frame), d.twistDq, d.twistDv,
+                          d.accelerationDq, d.accelerationDv, d.accelerationDa);
+    d.spatial.middleRows<6>(6 * i) = d.twistDv;
+    d.twistByAngle.middleRows<6>(6 * i) = d.twistDq;
+    d.accelerationByAngle.middleRows<6>(6 * i) = d.accelerationDq;
+    d.accelerationByVelocity.middleRows<6>(6 * i) = d.accelerationDv;
+  }
+  for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
+  d.lu.compute(d.closing);
+  Eigen::MatrixXd& M = *map;
+  auto Mq = M.topRows(c), Mv = M.middleRows(c, c), Ma = M.bottomRows(c);
+  // Right-hand sides in the other joints' columns (the closing joints' zeroed), then the
+  // closing joints' own terms through the rows already solved.
+  auto withoutClosing = [&](Eigen::Ref<Eigen::MatrixXd> block) {
+    for (const int j : closing_) block.col(j).setZero();
+  };
+  d.rhs.setZero();
+  d.rhs.leftCols(n) = d.spatial;
+  withoutClosing(d.rhs.leftCols(n));
+  Mq = d.lu.solve(d.rhs);
+  Mq *= -1.0;
+
+  d.rhs.leftCols(n) = d.twistByAngle;
+  d.rhs.middleCols(n, n) = d.spatial;
+  d.rhs.rightCols(n).setZero();
+  withoutClosing(d.rhs.leftCols(n));
+  withoutClosing(d.rhs.middleCols(n, n));
+  for (int k = 0; k < c; ++k) d.rhs.noalias() += d.twistByAngle.col(closing_[static_cast<std::size_t>(k)]) * Mq.row(k);
+  Mv = d.lu.solve(d.rhs);
+  Mv *= -1.0;
+
+  d.rhs.leftCols(n) = d.accelerationByAngle;
+  d.rhs.middleCols(n, n) = d.accelerationByVelocity;
+  d.rhs.rightCols(n) = d.spatial;
+  withoutClosing(d.rhs.leftCols(n));
+  withoutClosing(d.rhs.middleCols(n, n));
+  withoutClosing(d.rhs.rightCols(n));
+  for (int k = 0; k < c; ++k) {
+    const int j = closing_[static_cast<std::size_t>(k)];
+    d.rhs.noalias() += d.accelerationByAngle.col(j) * Mq.row(k);
+    d.rhs.noalias() += d.accelerationByVelocity.col(j) * Mv.row(k);
+  }
+  Ma = d.lu.solve(d.rhs);
+  Ma *= -1.0;
+  return true;
+}
+
+}  // namespace mcopt

@@ -1,0 +1,200 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// Contacts held over the whole motion by construction (outer_nlp/closed_chains.hpp): the
+// closure's map against central differences of the closure itself, the held frame on a fine
+// grid between the samples (pose, velocity), the closing joints' limits as rows, and the
+// refusals (a loop with too few joints, a singular one, the exact Hessian option). The motion
+// problem's derivatives through the closure are in test_multi_contact_problem.cpp (the weight
+// shift's right sole is such a contact).
+#include <catch2/catch.hpp>
+
+#include <random>
+
+#include "common/perturbed_motion.hpp"
+#include "common/test_support.hpp"
+#include "core/inverse_dynamics.hpp"
+#include "core/kinematics.hpp"
+#include "outer_nlp/closed_chains.hpp"
+#include "outer_nlp/motion_problem.hpp"
+
+namespace mcopt {
+
+namespace {
+
+Scenario weightShift() {
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
+  s.samples = 16;
+  s.outputSamples = 20;
+  return s;
+}
+
+/// The weight shift's right sole, held where half-sitting puts it, with the left sole the reference.
+HeldContact rightSole(const Scenario& s) {
+  for (const EnvironmentContact& c : s.contacts)
+    if (c.surface.name == "r_sole") return {c.surface.name, c.surface.frame, c.surface.placement, c.worldPose};
+  FAIL("no r_sole contact");
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("closed chains: the closure's map is its derivative (central differences)", "[outer][closure]") {
+  const Scenario s = weightShift();
+  const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
+  const ClosedChains chains(model, {rightSole(s)}, s.start);
+  REQUIRE(chains.closingCount() == 6);
+  for (const int j : chains.closingJoints()) CHECK(s.robot.joints[static_cast<std::size_t>(j)].name.rfind("RLEG", 0) == 0);
+  const int n = model.jointCount(), c = chains.closingCount();
+  ClosedChainData d(model, 1);
+  std::mt19937 random(3);
+  Eigen::VectorXd q = s.start + test::randomVector(random, n, 0.05), v = test::randomVector(random, n, 0.5),
+                  a = test::randomVector(random, n, 2.0);
+  Eigen::MatrixXd map(3 * c, 3 * n);
+  REQUIRE(chains.close(model, d, q, v, a, &map));
+  // The contact holds: pose, twist and acceleration of the frame.
+  CHECK(chains.poseError(model, d, q).first < 1e-11);
+  CHECK(chains.poseError(model, d, q).second < 1e-11);
+  inverseDynamics(model, d.data, q, v, a);
+  const int body = model.framePosition(rightSole(s).frame);
+  CHECK(d.data.linearVelocity[static_cast<std::size_t>(body)].norm() < 1e-12);
+  CHECK(d.data.angularVelocity[static_cast<std::size_t>(body)].norm() < 1e-12);
+  CHECK((d.data.linearAcceleration[static_cast<std::size_t>(body)] - d.data.linearAcceleration[0]).norm() < 1e-10);
+  CHECK((d.data.angularAcceleration[static_cast<std::size_t>(body)] - d.data.angularAcceleration[0]).norm() < 1e-10);
+
+  auto closedState = [&](Eigen::VectorXd x) {
+    Eigen::VectorXd qq = x.head(n), vv = x.segment(n, n), aa = x.tail(n);
+    REQUIRE(chains.close(model, d, qq, vv, aa, nullptr));
+    Eigen::VectorXd out(3 * c);
+    for (int k = 0; k < c; ++k) {
+      const int j = chains.closingJoints()[static_cast<std::size_t>(k)];
+      out[k] = qq[j], out[c + k] = vv[j], out[2 * c + k] = aa[j];
+    }
+    return out;
+  };
+  Eigen::VectorXd x(3 * n);
+  x << q, v, a;
+  double worst = 0.0;
+  for (int col = 0; col < 3 * n; ++col) {
+    if (chains.closes(col % n)) {
+      CHECK(map.col(col).norm() == 0.0);  // the closing joints' own columns
+      continue;
+    }
+    const double h = 1e-6;
+    Eigen::VectorXd plus = x, minus = x;
+    plus[col] += h, minus[col] -= h;
+    const Eigen::VectorXd fd = (closedState(plus) - closedState(minus)) / (2 * h);
+    worst = std::max(worst, ((map.col(col) - fd).array().abs() / (1.0 + fd.array().abs())).maxCoeff());
+  }
+  INFO("worst relative error of the map " << worst);
+  CHECK(worst < 1e-6);
+}
+
+TEST_CASE("closed chains: the held sole stays put between the samples, whichever motion", "[outer][closure]") {
+  Scenario s = weightShift();
+  s.fixStart = s.fixEnd = false;
+  MotionProblem problem(s);
+  REQUIRE(problem.closedChains() != nullptr);
+  CHECK(problem.closedChains()->contacts().front().name == "r_sole");
+  const Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 11);
+  const SampledPhysics p = problem.sampledPhysics(x);
+  // Fine grid: 10 instants a sample interval; the band this replaces left 1.7 mm.
+  INFO("drift " << p.closureDrift[0] << " m, " << p.closureRotationDrift[0] << " rad; sliding " << p.closureSpeed[0]
+                << " m/s, turning " << p.closureAngularSpeed[0] << " rad/s");
+  CHECK(p.closureDrift[0] < 1e-10);
+  CHECK(p.closureRotationDrift[0] < 1e-10);
+  CHECK(p.closureSpeed[0] < 1e-9);
+  CHECK(p.closureAngularSpeed[0] < 1e-9);
+  // The closing joints move (they are the closure's, not their fixed splines).
+  double motion = 0.0;
+  for (const int j : problem.closedChains()->closingJoints()) motion = std::max(motion, p.q.row(j).maxCoeff() - p.q.row(j).minCoeff());
+  CHECK(motion > 1e-3);
+  // Their limits are rows at every sample.
+  int rows = 0;
+  for (int r = 0; r < problem.constraintCount(); ++r) rows += problem.rowKind(r) == ConstraintKind::ClosingJointLimit;
+  CHECK(rows >= 6 * problem.sampleCount());
+}
+
+TEST_CASE("closed chains: a loop that cannot be closed is refused, naming the contact", "[outer][closure]") {
+  const Scenario s = weightShift();
+  const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
+  // A frame on the reference leg's knee: two joints from the reference body.
+  HeldContact knee{"knee", s.robot.frameIndex("LLEG_LINK3"), RigidTransform{}, RigidTransform{}};
+  CHECK_THROWS_WITH(ClosedChains(model, {knee}, s.start), Catch::Contains("contact 'knee'") && Catch::Contains("takes six"));
+  // Straight legs (posture zero): the right leg's six joints cannot move the sole along the leg.
+  CHECK_THROWS_WITH(ClosedChains(model, {rightSole(s)}, Eigen::VectorXd::Zero(model.jointCount())),
+                    Catch::Contains("contact 'r_sole'") && Catch::Contains("singular"));
+  // The exact Hessian option has no stencil for the closure's map.
+  Scenario exact = weightShift();
+  exact.contactForces = ContactForces::Splines;
+  exact.hessian = HessianOption::Exact;
+  CHECK_THROWS_WITH(MotionProblem(exact), Catch::Contains("contact 'r_sole' is held over the whole motion by construction"));
+}
+
+}  // namespace mcopt
+
+
+namespace mcopt {
+
+TEST_CASE("closed chains: the same motion's torques and wrenches do not depend on which sole is the reference",
+          "[outer][closure]") {
+  // The multi-contact scenarios' motions (their closure exact), rooted at the left sole as
+  // bundled; the same states rooted at the right sole, where the bundled left-rooted motion puts
+  // it, with each sample's inner problem solved again there: the same torques and wrenches.
+  // With the right sole held by a band instead (a window over the whole motion), it slides,
+  // and the same comparison shows it.
+  for (const char* name : {"hrp2_weight_shift.yaml", "hrp2_lean_reach.yaml"}) {
+    for (const bool band : {false, true}) {
+      Scenario s = loadScenario(test::sourceDir() / "scenarios" / name);
+      s.samples = 16;
+      s.outputSamples = 20;
+      if (band) {
+        for (EnvironmentContact& c : s.contacts) c.window = true;
+        for (TaskSpec& t : s.tasks) t.heldThroughout = false;
+      }
+      MotionProblem problem(s);
+      REQUIRE((problem.closedChains() == nullptr) == band);
+      const Eigen::VectorXd x = test::perturbedMotion(problem, 0.03, 5);
+      const SampledPhysics left = problem.sampledPhysics(x);
+      REQUIRE(left.infeasibleSamples == 0);
+
+      // The right-rooted model, its sole at the world pose the left-rooted start puts it.
+      const EnvironmentContact& rightSole = s.contacts.front();
+      REQUIRE(rightSole.surface.name == "r_sole");
+      const RigidTransform rootPose = rightSole.worldPose * rightSole.surface.placement.inverse();
+      const DynamicsModel right(s.robot, s.robot.frames[static_cast<std::size_t>(rightSole.surface.frame)].name, rootPose, s.gravity);
+      DynamicsData data(right);
+      const auto solver = makeInnerSolver(s.inner.solverName, s.inner.solver);
+      double torqueError = 0.0, wrenchError = 0.0, torqueScale = 0.0;
+      for (Eigen::Index k = 0; k < left.time.size(); ++k) {
+        // The right sole first (the reference), then the left one, then the others active here.
+        std::vector<ContactSurface> surfaces{rightSole.surface, s.support};
+        std::vector<int> fromLeft{1, 0};  // each surface's index in left.wrenches
+        for (std::size_t c = 1; c < s.contacts.size(); ++c)
+          if (left.active[c + 1][static_cast<std::size_t>(k)]) surfaces.push_back(s.contacts[c].surface), fromLeft.push_back(static_cast<int>(c) + 1);
+        SampleProblem sample(right, surfaces, s.inner.problem);
+        inverseDynamics(right, data, left.q.col(k), left.v.col(k), left.a.col(k));
+        sample.update(right, data, s.actuators, surfaces, left.v.col(k), left.a.col(k));
+        InnerResult result;
+        solver->solve(sample.problem, result);
+        REQUIRE(result.status == InnerStatus::Optimal);
+        const Eigen::VectorXd torque = data.tau - sample.wrenchToTorque * result.wrenches;
+        torqueError = std::max(torqueError, (torque - left.tau.col(k)).cwiseAbs().maxCoeff());
+        torqueScale = std::max(torqueScale, left.tau.col(k).cwiseAbs().maxCoeff());
+        for (std::size_t c = 0; c < surfaces.size(); ++c)
+          wrenchError = std::max(wrenchError, (result.wrenches.segment<6>(6 * static_cast<Eigen::Index>(c)) -
+                                               left.wrenches[static_cast<std::size_t>(fromLeft[c])].col(k))
+                                                  .cwiseAbs()
+                                                  .maxCoeff());
+      }
+      INFO(name << (band ? ", right sole held by a band" : ", right sole held by construction") << ": torques differ by "
+                << torqueError << " N m (largest " << torqueScale << "), wrenches by " << wrenchError << " N or N m");
+      if (band) {
+        CHECK(torqueError > 1e-2);  // the sole slides: the rooting changes the torques
+      } else {
+        CHECK(torqueError < 1e-6 * torqueScale);
+        CHECK(wrenchError < 1e-5);
+      }
+    }
+  }
+}
+
+}  // namespace mcopt
