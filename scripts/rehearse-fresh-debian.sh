@@ -98,10 +98,11 @@ timed() {  # name, command...
 }
 
 if [ -n "$deb" ]; then
-  cp "$deb" "$root_dir/tmp/"
-  package="/tmp/$(basename "$deb")"
+  # In the home of the root's user, installed from there as a user does: apt-get install ./FILE.
+  cp "$deb" "$home_in_root/"
+  package="./$(basename "$deb")"
   status=0
-  timed "apt-get install ./$(basename "$deb")" "apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $package" || status=$?
+  timed "apt-get install $package" "cd ~ && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $package" || status=$?
   if [ $status -eq 0 ]; then
     timed "mcopt --version" "mcopt --version" || status=$?
     timed "mcopt run" "cd ~ && mcopt run /usr/share/mcopt/scenarios/hrp2_throw.yaml --out out/throw && grep -q '\"status\": \"optimal\"' out/throw/result.json" || status=$?

@@ -18,6 +18,18 @@ step="$1"; build="$(cd "$2" && pwd)"; source="$(cd "$3" && pwd)"; work="$4"
 prefix="$work/prefix"
 mkdir -p "$work"
 fail() { echo "check_install $step: $*" >&2; exit 1; }
+# An installed command under PREFIX: `--version`, then the bundled throw from PREFIX/share/mcopt
+# capped at 3 iterations (exit 0, or 4: not optimal yet) in the current folder; sets $code.
+run_installed() {  # PREFIX WHAT
+  local p="$1" what="$2"
+  "$p/bin/mcopt" --version | grep -qx "mcopt [0-9]*\.[0-9]*\.[0-9]*" || fail "$what: mcopt --version"
+  set +e
+  "$p/bin/mcopt" run "$p/share/mcopt/scenarios/hrp2_throw.yaml" --out out --max-iterations 3 > run.log 2>&1
+  code=$?
+  set -e
+  [ $code -eq 0 ] || [ $code -eq 4 ] || { cat run.log; fail "$what: mcopt run ended $code"; }
+  [ -f out/result.json ] || fail "$what: no result.json"
+}
 python=/usr/bin/python3
 
 case "$step" in
@@ -98,14 +110,8 @@ command)
   rm -rf "$work/command"; mkdir -p "$work/command"
   cp -a "$prefix" "$work/command/prefix"   # a copy, whose scripts can be told apart from the source tree's
   p="$work/command/prefix"
-  "$p/bin/mcopt" --version | grep -qx "mcopt [0-9]*\.[0-9]*\.[0-9]*" || fail "mcopt --version"
   cd "$work/command"
-  set +e
-  "$p/bin/mcopt" run "$p/share/mcopt/scenarios/hrp2_throw.yaml" --out out --max-iterations 3 > run.log 2>&1
-  code=$?
-  set -e
-  [ $code -eq 0 ] || [ $code -eq 4 ] || { cat run.log; fail "mcopt run from the prefix ended $code"; }
-  [ -f out/result.json ] || fail "no result.json"
+  run_installed "$p" "the prefix"
   # The installed plotting script and replay template are the ones used: marked copies show it.
   printf 'import sys\nprint("installed plot script", sys.argv[1:])\n' > "$p/share/mcopt/scripts/plot_result.py"
   "$p/bin/mcopt" plot out | grep -q "installed plot script" || fail "mcopt plot did not run share/mcopt/scripts/plot_result.py"
@@ -142,13 +148,8 @@ deb)
   dpkg --root="$root" --force-depends --force-not-root --force-script-chrootless -i "$package" > "$work/deb/dpkg.log" 2>&1 \
     || { cat "$work/deb/dpkg.log"; fail "dpkg -i into the scratch root failed"; }
   [ -x "$root/usr/bin/mcopt" ] || fail "no usr/bin/mcopt in the package"
-  "$root/usr/bin/mcopt" --version
   cd "$work/deb"
-  set +e
-  "$root/usr/bin/mcopt" run "$root/usr/share/mcopt/scenarios/hrp2_throw.yaml" --out out --max-iterations 3 > run.log 2>&1
-  code=$?
-  set -e
-  [ $code -eq 0 ] || [ $code -eq 4 ] || { cat run.log; fail "the packaged mcopt run ended $code"; }
+  run_installed "$root/usr" "the package"
   # The module sits where Debian's python3 looks under /usr.
   "$python" -c "import sys; assert '/usr/lib/python3/dist-packages' in sys.path" || fail "Debian's python3 does not search /usr/lib/python3/dist-packages"
   PYTHONPATH="$root/usr/lib/python3/dist-packages" "$python" -c "import mcopt; assert mcopt.__file__.startswith('$root/usr/lib/python3/dist-packages/'), mcopt.__file__; print('import mcopt', mcopt.__version__)"
