@@ -269,7 +269,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       h.objectiveGradient.setZero(largest), h.stateByDuration.setZero(largest), h.durationRow.setZero(largest);
       h.wrenchJacobian.setZero(6, largest), h.curvedWrenchJacobian.setZero(6, largest);
       const int closing = 3 * outputs_.closing;
-      h.foldColumns.setZero(largest, closing), h.foldRows.setZero(closing, largest), h.foldDuration.setZero(closing);
+      h.foldColumns.setZero(largest, closing), h.foldRows.setZero(closing, largest);
       h.probeMap.setZero(closing, 3 * n), h.closedState.setZero(3 * n);
     }
     localHessians_.assign(blocks_.size() + taskBlocks_.size(), LocalHessian{});
@@ -323,33 +323,15 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         const std::vector<int>& closing = closure_->closingJoints();
         const auto M = map->topLeftCorner(sc, stateBlocks * n);
         auto Hfull = h.stateHessian.topLeftCorner(d, d);
-        auto G = h.foldColumns.topLeftCorner(d, sc);
-        for (int block = 0; block < stateBlocks; ++block)
-          for (int kk = 0; kk < c; ++kk) {
-            const int at = block * n + closing[static_cast<std::size_t>(kk)];
-            G.col(block * c + kk) = Hfull.col(at);
-            Hfull.col(at).setZero();
-          }
+        // The map's row g is closing joint g % c's in state block g / c.
+        auto stateOf = [&](int g) { return (g / c) * n + closing[static_cast<std::size_t>(g % c)]; };
+        auto G = h.foldColumns.topLeftCorner(d, sc);  // H T: the closing columns through the map
+        for (int g = 0; g < sc; ++g) G.col(g) = Hfull.col(stateOf(g)), Hfull.col(stateOf(g)).setZero();
         Hfull.leftCols(stateBlocks * n).noalias() += G * M;
-        auto R = h.foldRows.topLeftCorner(sc, d);
-        for (int block = 0; block < stateBlocks; ++block)
-          for (int kk = 0; kk < c; ++kk) {
-            const int at = block * n + closing[static_cast<std::size_t>(kk)];
-            R.row(block * c + kk) = Hfull.row(at);
-            Hfull.row(at).setZero();
-          }
+        auto R = h.foldRows.topLeftCorner(sc, d);  // Tᵀ (H T): the closing rows likewise
+        for (int g = 0; g < sc; ++g) R.row(g) = Hfull.row(stateOf(g)), Hfull.row(stateOf(g)).setZero();
         Hfull.topRows(stateBlocks * n).noalias() += M.transpose() * R;
-        if (duration) {
-          auto r = h.durationRow.head(d);
-          auto rc = h.foldDuration.head(sc);
-          for (int block = 0; block < stateBlocks; ++block)
-            for (int kk = 0; kk < c; ++kk) {
-              const int at = block * n + closing[static_cast<std::size_t>(kk)];
-              rc[block * c + kk] = r[at];
-              r[at] = 0.0;
-            }
-          r.head(stateBlocks * n).noalias() += M.transpose() * rc;
-        }
+        if (duration) foldGradient(*map, stateBlocks, h.durationRow.head(stateBlocks * n));
       }
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};

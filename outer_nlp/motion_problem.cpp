@@ -608,6 +608,11 @@ bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::
   return closure_->close(model_, w.closure, w.q, w.v, w.a, map);
 }
 
+void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives) {
+  if (!closure_ || !closeState(b, w, derivatives ? &b.closureMap : nullptr)) return;
+  for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+}
+
 void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
                                 Eigen::MatrixXd& da) const {
   // ∂y/∂x_F = ∂y/∂x_F|_C fixed + ∂y/∂x_C M, x = (q, q̇, q̈); the closing joints' own columns then read zero.
@@ -639,8 +644,7 @@ void MotionProblem::foldGradient(const Eigen::MatrixXd& map, int stateBlocks, Ei
 void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
   samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
-  if (closure_ && closeState(b, w, derivatives ? &b.closureMap : nullptr))
-    for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+  closeAndRemember(b, w, derivatives);
   sampleOutputs(s, x, derivatives, w, b);
   if (!derivatives) return;
   if (closure_) {
@@ -683,18 +687,6 @@ Eigen::VectorXd MotionProblem::reportedMotionParameters(const Eigen::VectorXd& x
     parameters.segment(j * m, m) = qr.solve(angles);
   }
   return parameters;
-}
-
-void MotionProblem::stateAt(const Eigen::VectorXd& x, double u, Eigen::VectorXd& q, Eigen::VectorXd& v,
-                            Eigen::VectorXd& a) const {
-  const SampledTrajectory at(parametrization_, std::vector<double>{u});
-  Eigen::MatrixXd controlPoints;
-  parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
-  q.resize(jointCount_), v.resize(jointCount_), a.resize(jointCount_);
-  at.evaluate(0, controlPoints, duration(x), q, v, a);
-  if (!closure_) return;
-  ClosedChainData d(model_, closure_->contactCount());
-  closure_->close(model_, d, q, v, a, nullptr);
 }
 
 void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w,
@@ -823,8 +815,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
 void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
   taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
-  if (closure_ && closeState(b, w, derivatives ? &b.closureMap : nullptr))
-    for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+  closeAndRemember(b, w, derivatives);
   taskOutputs(i, derivatives, w, b);
   if (!derivatives) return;
   if (closure_) {

@@ -159,8 +159,6 @@ class MotionProblem final : public NlpProblem {
   /// The contacts held over the whole motion by construction, and their closing joints (null:
   /// none, every contact has a window).
   const ClosedChains* closedChains() const { return closure_.get(); }
-  /// The motion's state at normalised time u: the splines', the closing joints' from the closure.
-  void stateAt(const Eigen::VectorXd& x, double u, Eigen::VectorXd& q, Eigen::VectorXd& v, Eigen::VectorXd& a) const;
 
   int variableCount() const override { return variableCount_; }
   int nonlinearVariableCount() const override { return slackStart_; }
@@ -306,6 +304,9 @@ class MotionProblem final : public NlpProblem {
   /// The closing joints' state in w.q, w.v, w.a from the others' (Newton from b's last angles),
   /// with the map into `map` when given. False when the loop cannot close there.
   bool closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const;
+  /// The same at an evaluation's own state: the map into b (with derivatives) and the angles
+  /// reached kept in b for the next Newton start.
+  void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives);
   /// Chain rule through the closure: (dyDq, dyDv, dyDa) of b, the closing joints' columns
   /// folded into the others' through b.closureMap, into dq, dv, da.
   void foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
@@ -330,10 +331,9 @@ class MotionProblem final : public NlpProblem {
     Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchJacobian, curvedWrenchJacobian;
     // A throw's task instant: the weights its flight puts on the ball's state (task_kinematics.hpp).
     Vector6 ballWeights = Vector6::Zero();
-    // Closed chains: the closing joints' columns and rows of H, and of the duration's row, set
-    // aside while the state Hessian is brought to the spline joints' (motion_hessian.cpp).
+    // Closed chains: the closing joints' columns and rows of H set aside while the state Hessian
+    // is brought to the spline joints' (motion_hessian.cpp).
     Eigen::MatrixXd foldColumns, foldRows;
-    Eigen::VectorXd foldDuration;
     // Closed chains, sample differences: the closure's map at a probe, and the closed state the
     // probes start from.
     Eigen::MatrixXd probeMap;
