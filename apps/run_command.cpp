@@ -143,6 +143,12 @@ int runMotion(const RunOptions& o) {
               << p.staticPowerAfter << " W (" << std::setprecision(3) << p.seconds << " s)"
               << (p.status == OuterStatus::Optimal ? "" : "  — NOT OPTIMAL (warning at the end)") << "\n";
   };
+  events.onContactPosture = [&](const RunRecord::ContactPosture& p) {
+    std::cout << "  posture reaching " << p.contact << " at " << std::setprecision(3) << p.time << " s: "
+              << toString(p.outcome.status) << " after " << p.outcome.iterations << " iterations, " << std::setprecision(3)
+              << p.distance << " rad from the start–end path (" << p.outcome.seconds << " s)"
+              << (p.outcome.status == OuterStatus::Optimal ? "" : "  — NOT OPTIMAL (warning at the end)") << "\n";
+  };
   events.onSolve = [&](const SolveStart& solve) {
     if (solve.joinedTorqueRows > 0)
       std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.torqueScreening

@@ -288,8 +288,17 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                      {"inner_status", c.innerStatus.empty() ? Json(nullptr) : Json(c.innerStatus)}});
   }
   result["fixed_postures"] = fixed;
+  Json reaches = Json::array();
+  for (const RunRecord::ContactPosture& p : record.contactPostures) {
+    Json entry = posture(p.outcome);
+    entry["contact"] = p.contact;
+    entry["time"] = p.time;
+    entry["distance_rad"] = p.distance;
+    reaches.push_back(entry);
+  }
   result["configuration_optimisation"] = {{"start", posture(record.start)},
-                                          {"end", scenario.periodic ? Json{{"same_as", "start"}} : posture(record.end)}};
+                                          {"end", scenario.periodic ? Json{{"same_as", "start"}} : posture(record.end)},
+                                          {"contacts", reaches}};
   result["timings"] = {{"configuration_seconds", record.configurationSeconds},
                        {"optimisation_seconds", record.optimisationSeconds},
                        {"total_seconds", record.totalSeconds},

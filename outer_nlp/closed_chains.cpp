@@ -35,6 +35,7 @@ ClosedChainData::ClosedChainData(const DynamicsModel& model, int contacts)
 ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> contacts, const Eigen::VectorXd& posture)
     : contacts_(std::move(contacts)), posture_(posture) {
   const int n = model.jointCount();
+  if (contacts_.size() > 32) throw InputError("more than 32 contacts to hold by construction");
   closes_.assign(static_cast<std::size_t>(n), false);
   contactOf_.assign(static_cast<std::size_t>(n), -1);
   for (std::size_t i = 0; i < contacts_.size(); ++i) {
@@ -76,8 +77,36 @@ ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> 
   }
 }
 
-void ClosedChains::poseResidual(const DynamicsModel& model, ClosedChainData& d) const {
+ClosureSet ClosedChains::closedAt(double u, bool ends) const {
+  ClosureSet set = 0;
   for (int i = 0; i < contactCount(); ++i) {
+    const std::array<double, 2>& w = contacts_[static_cast<std::size_t>(i)].window;
+    const bool inside = wholeMotion(i) || (ends ? u >= w[0] - 1e-9 && u <= w[1] + 1e-9 : u > w[0] + 1e-9 && u < w[1] - 1e-9);
+    if (inside) set |= ClosureSet{1} << i;
+  }
+  return set;
+}
+
+bool ClosedChains::wholeMotion(int contact) const {
+  const std::array<double, 2>& w = contacts_[static_cast<std::size_t>(contact)].window;
+  return w[0] <= 0.0 && w[1] >= 1.0;
+}
+
+void ClosedChains::keepOpen(ClosedChainData& d, ClosureSet set) const {
+  for (int i = 0; i < contactCount(); ++i) {
+    if ((set >> i) & 1U) continue;
+    d.closing.middleRows<6>(6 * i).setZero();
+    d.closing.block<6, 6>(6 * i, 6 * i).setIdentity();
+    d.residual.segment<6>(6 * i).setZero();
+  }
+}
+
+void ClosedChains::poseResidual(const DynamicsModel& model, ClosedChainData& d, ClosureSet set) const {
+  for (int i = 0; i < contactCount(); ++i) {
+    if (!((set >> i) & 1U)) {
+      d.residual.segment<6>(6 * i).setZero();
+      continue;
+    }
     const HeldContact& c = contacts_[static_cast<std::size_t>(i)];
     const RigidTransform pose = framePose(model, d.data, c.frame) * c.placement;
     d.residual.segment<3>(6 * i) = pose.translation - c.worldPose.translation;
@@ -86,9 +115,10 @@ void ClosedChains::poseResidual(const DynamicsModel& model, ClosedChainData& d) 
   }
 }
 
-std::pair<double, double> ClosedChains::poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q) const {
+std::pair<double, double> ClosedChains::poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q,
+                                                  ClosureSet set) const {
   forwardKinematics(model, d.data, q);
-  poseResidual(model, d);
+  poseResidual(model, d, set);
   double distance = 0.0, angle = 0.0;
   for (int i = 0; i < contactCount(); ++i)
     distance = std::max(distance, d.residual.segment<3>(6 * i).norm()), angle = std::max(angle, d.residual.segment<3>(6 * i + 3).norm());
@@ -96,9 +126,15 @@ std::pair<double, double> ClosedChains::poseError(const DynamicsModel& model, Cl
 }
 
 bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q,
-                         Eigen::Ref<Eigen::VectorXd> v, Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map) const {
-  if (empty()) return true;
+                         Eigen::Ref<Eigen::VectorXd> v, Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map,
+                         ClosureSet set) const {
+  set &= all();
+  if (set == 0) {
+    if (map) map->setZero();
+    return true;
+  }
   const int c = closingCount(), n = model.jointCount();
+  auto closed = [&](int k) { return ((set >> contactOf_[static_cast<std::size_t>(closing_[static_cast<std::size_t>(k)])]) & 1U) != 0; };
   // The closing joints' point-form Jacobian columns at the pose in d.data: (linear velocity of
   // the frame origin, angular velocity), world axes — e's derivative at e = 0.
   auto closingJacobian = [&](bool full) {
@@ -116,25 +152,26 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   auto newton = [&]() {
     double previous = std::numeric_limits<double>::infinity();
     forwardKinematics(model, d.data, q);
-    poseResidual(model, d);
+    poseResidual(model, d, set);
     for (int iteration = 0; iteration < kNewtonIterations; ++iteration) {
       if (!d.residual.allFinite()) return false;
       const double size = d.residual.lpNorm<Eigen::Infinity>();
       if (size < kPoseTolerance || (size < kPoseFloor && size > 0.5 * previous)) return true;
       previous = size;
       closingJacobian(false);
+      keepOpen(d, set);
       d.lu.compute(d.closing);
       d.step.noalias() = d.lu.solve(d.residual);
       double scale = 1.0;
       for (int halving = 0; halving < 12; ++halving, scale *= 0.5) {
         for (int k = 0; k < c; ++k) q[closing_[static_cast<std::size_t>(k)]] -= scale * d.step[k];
         forwardKinematics(model, d.data, q);
-        poseResidual(model, d);
+        poseResidual(model, d, set);
         if (d.residual.allFinite() && (d.residual.lpNorm<Eigen::Infinity>() < size || size < kPoseFloor)) break;
         for (int k = 0; k < c; ++k) q[closing_[static_cast<std::size_t>(k)]] += scale * d.step[k];
         if (halving == 11) {  // no decrease along the step: leave the residual of q as it is
           forwardKinematics(model, d.data, q);
-          poseResidual(model, d);
+          poseResidual(model, d, set);
           return d.residual.lpNorm<Eigen::Infinity>() < kPoseFloor;
         }
       }
@@ -143,25 +180,34 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   };
   bool converged = newton();
   if (!converged) {
-    for (const int j : closing_) q[j] = posture_[j];
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) q[closing_[static_cast<std::size_t>(k)]] = posture_[closing_[static_cast<std::size_t>(k)]];
     converged = newton();
   }
   if (!converged) {
-    for (const int j : closing_) q[j] = v[j] = a[j] = std::numeric_limits<double>::quiet_NaN();
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) {
+        const int j = closing_[static_cast<std::size_t>(k)];
+        q[j] = v[j] = a[j] = std::numeric_limits<double>::quiet_NaN();
+      }
     if (map) map->setConstant(std::numeric_limits<double>::quiet_NaN());
     return false;
   }
   // Velocities: J (q̇ with q̇_C = 0) + J_C q̇_C = 0.
   closingJacobian(true);
-  for (const int j : closing_) v[j] = 0.0;
+  for (int k = 0; k < c; ++k)
+    if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = 0.0;
   d.residual.noalias() = d.spatial * v;
+  keepOpen(d, set);
   d.lu.compute(d.closing);
   d.step.noalias() = d.lu.solve(d.residual);
-  for (int k = 0; k < c; ++k) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
+  for (int k = 0; k < c; ++k)
+    if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
   // Accelerations: the spatial acceleration with q̈_C = 0, against the fixed world's (the
   // reference body's, gravity folded in), then S_C q̈_C cancels the difference. S is the frame
   // Jacobian about the world origin.
-  for (const int j : closing_) a[j] = 0.0;
+  for (int k = 0; k < c; ++k)
+    if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = 0.0;
   inverseDynamics(model, d.data, q, v, a);
   for (int i = 0; i < contactCount(); ++i) {
     const int body = model.framePosition(contacts_[static_cast<std::size_t>(i)].frame);
@@ -171,9 +217,11 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     d.spatial.middleRows<6>(6 * i) = d.jacobian;
   }
   for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
+  keepOpen(d, set);
   d.lu.compute(d.closing);
   d.step.noalias() = d.lu.solve(d.residual);
-  for (int k = 0; k < c; ++k) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
+  for (int k = 0; k < c; ++k)
+    if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
   if (!map) return true;
 
   // ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) by the implicit function theorem, at the closed state.
@@ -187,17 +235,25 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     d.accelerationByVelocity.middleRows<6>(6 * i) = d.accelerationDv;
   }
   for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
+  keepOpen(d, set);
   d.lu.compute(d.closing);
   Eigen::MatrixXd& M = *map;
   auto Mq = M.topRows(c), Mv = M.middleRows(c, c), Ma = M.bottomRows(c);
-  // Right-hand sides in the other joints' columns (the closing joints' zeroed), then the
-  // closing joints' own terms through the rows already solved.
+  // Right-hand sides in the other joints' columns (the closed joints' zeroed), then the
+  // closed joints' own terms through the rows already solved; an open contact's rows zero
+  // (its rows of the system are the identity: its joints are not the closure's).
   auto withoutClosing = [&](Eigen::Ref<Eigen::MatrixXd> block) {
-    for (const int j : closing_) block.col(j).setZero();
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) block.col(closing_[static_cast<std::size_t>(k)]).setZero();
+  };
+  auto openRowsZero = [&]() {
+    for (int i = 0; i < contactCount(); ++i)
+      if (!((set >> i) & 1U)) d.rhs.middleRows<6>(6 * i).setZero();
   };
   d.rhs.setZero();
   d.rhs.leftCols(n) = d.spatial;
   withoutClosing(d.rhs.leftCols(n));
+  openRowsZero();
   Mq = d.lu.solve(d.rhs);
   Mq *= -1.0;
 
@@ -206,7 +262,9 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   d.rhs.rightCols(n).setZero();
   withoutClosing(d.rhs.leftCols(n));
   withoutClosing(d.rhs.middleCols(n, n));
-  for (int k = 0; k < c; ++k) d.rhs.noalias() += d.twistByAngle.col(closing_[static_cast<std::size_t>(k)]) * Mq.row(k);
+  for (int k = 0; k < c; ++k)
+    if (closed(k)) d.rhs.noalias() += d.twistByAngle.col(closing_[static_cast<std::size_t>(k)]) * Mq.row(k);
+  openRowsZero();
   Mv = d.lu.solve(d.rhs);
   Mv *= -1.0;
 
@@ -217,10 +275,12 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   withoutClosing(d.rhs.middleCols(n, n));
   withoutClosing(d.rhs.rightCols(n));
   for (int k = 0; k < c; ++k) {
+    if (!closed(k)) continue;
     const int j = closing_[static_cast<std::size_t>(k)];
     d.rhs.noalias() += d.accelerationByAngle.col(j) * Mq.row(k);
     d.rhs.noalias() += d.accelerationByVelocity.col(j) * Mv.row(k);
   }
+  openRowsZero();
   Ma = d.lu.solve(d.rhs);
   Ma *= -1.0;
   return true;

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// Contacts held over the whole motion, by construction (formulation.md §10, "Contacts that
-// hold"; docs/theory/outer-problem.md). Every environment contact without a window closes a
-// kinematic loop through the reference body. Six joints of that loop — the six nearest the
-// contact's body — are not splines: at every instant they are what keeps the contact frame at
-// its world pose with zero velocity and zero acceleration, given the other joints:
+// Contacts held by construction (formulation.md §10, "Contacts that hold";
+// docs/theory/outer-problem.md). Every environment contact closes a kinematic loop through the
+// reference body. Six joints of that loop — the six nearest the contact's body — are not
+// splines while the contact is active (over the whole motion, or over its window): at every
+// such instant they are what keeps the contact frame at its world pose with zero velocity and
+// zero acceleration, given the other joints:
 //   pose      e(q) = 0                       (frame origin and orientation, world axes)
 //   velocity  V(q, q̇) = S q̇ = 0               (the body's spatial twist)
 //   acceleration A(q, q̇, q̈) − A_ref = 0        (its spatial acceleration, the reference body's
@@ -17,10 +18,14 @@
 //   M_a = −S_C⁻¹ ([A_q,F A_v,F S_F] + A_q,C M_q + A_v,C M_v)
 // where S is the spatial Jacobian, V_q = ∂V/∂q, A_q, A_v = ∂A/∂q, ∂A/∂q̇ (core/motion_derivatives.hpp),
 // F the other joints' columns, C the closing joints'. The contact then holds exactly at every
-// instant, between the samples too, whichever body is the reference.
+// instant, between the samples too, whichever body is the reference. Outside its window a
+// contact's closing joints are splines like the others; the outer problem makes the two meet
+// at the window's ends (the frame at its pose, at rest: motion_problem.hpp).
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -32,12 +37,17 @@
 
 namespace mcopt {
 
-/// A contact to hold: the frame (RobotModel frame and placement) and its world pose.
+/// A contact to hold: the frame (RobotModel frame and placement), its world pose and its
+/// window as fractions of the motion ([0, 1]: the whole motion).
 struct HeldContact {
   std::string name;
   int frame = -1;
   RigidTransform placement, worldPose;
+  std::array<double, 2> window{0.0, 1.0};
 };
+
+/// Which contacts are closed at an instant: bit i for contact i.
+using ClosureSet = std::uint32_t;
 
 /// Per-thread buffers of ClosedChains::close, sized once (no allocation afterwards).
 struct ClosedChainData {
@@ -58,6 +68,7 @@ class ClosedChains {
   /// reference body, not already closing another contact. Throws InputError naming the
   /// contact when its loop has fewer than six free joints, or when they cannot move its frame
   /// in all six directions at `posture` (a singular choice).
+  /// At most 32 contacts (ClosureSet's bits).
   ClosedChains(const DynamicsModel& model, std::vector<HeldContact> contacts, const Eigen::VectorXd& posture);
 
   bool empty() const { return contacts_.empty(); }
@@ -69,21 +80,40 @@ class ClosedChains {
   bool closes(int joint) const { return closes_[static_cast<std::size_t>(joint)]; }
   /// The contact a closing joint holds.
   int contactOf(int joint) const { return contactOf_[static_cast<std::size_t>(joint)]; }
+  /// Every contact.
+  ClosureSet all() const { return contacts_.size() >= 32 ? ~ClosureSet{0} : (ClosureSet{1} << contacts_.size()) - 1; }
+  /// The contacts closed at u (a fraction of the motion): those held over the whole motion, and
+  /// those whose window holds u — its ends included with `ends`, not without (a window's end is
+  /// where the splines meet the closure: there the state is the splines').
+  ClosureSet closedAt(double u, bool ends) const;
+  bool wholeMotion(int contact) const;
+  /// Whether a joint closes a contact of `set`.
+  bool closesIn(int joint, ClosureSet set) const {
+    const int c = contactOf_[static_cast<std::size_t>(joint)];
+    return c >= 0 && ((set >> c) & 1U);
+  }
 
-  /// Replaces the closing joints' entries of (q, v, a) by the closure's, Newton's method (its
-  /// step halved while it does not reduce the residual) starting from q's own, then, if that
-  /// fails, from the start posture's. With `map` (3c × 3n, written): ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈), zero
-  /// in the closing joints' columns. Returns false, with those entries NaN, when Newton's
+  /// Replaces the entries of (q, v, a) of the joints closing the contacts of `set` by the
+  /// closure's, Newton's method (its step halved while it does not reduce the residual)
+  /// starting from q's own, then, if that fails, from the start posture's; the other joints,
+  /// the other contacts' closing joints included, stay as given. With `map` (3c × 3n, written):
+  /// ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈), zero in the closed joints' columns and in the rows of the
+  /// joints of contacts outside `set`. Returns false, with the closed entries NaN, when Newton's
   /// method does not reach the pose (a loop that cannot close: a step too far for Ipopt).
   bool close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> v,
-             Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map) const;
+             Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map, ClosureSet set) const;
 
-  /// The largest distance [m] and angle [rad] of a held frame from its world pose at q.
-  std::pair<double, double> poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q) const;
+  /// The largest distance [m] and angle [rad] of a frame of `set` from its world pose at q.
+  std::pair<double, double> poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q,
+                                      ClosureSet set) const;
 
  private:
-  /// e(q): per contact (p − p*, log(R R*ᵀ)), world axes; frame poses from d.data (forward kinematics done).
-  void poseResidual(const DynamicsModel& model, ClosedChainData& d) const;
+  /// e(q): per contact of `set` (p − p*, log(R R*ᵀ)), world axes, zero for the others; frame
+  /// poses from d.data (forward kinematics done).
+  void poseResidual(const DynamicsModel& model, ClosedChainData& d, ClosureSet set) const;
+  /// In d.closing and d.residual: a contact outside `set` keeps its closing joints, its rows
+  /// the identity on their columns with a zero right-hand side (their step is zero).
+  void keepOpen(ClosedChainData& d, ClosureSet set) const;
   std::vector<HeldContact> contacts_;
   Eigen::VectorXd posture_;  ///< the start posture: Newton's second start
   std::vector<int> closing_, contactOf_;

@@ -12,10 +12,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 }  // namespace
 
 ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const DynamicsModel& model,
-                                           const ContactAdmissibilityRows& support, double instant)
+                                           const ContactAdmissibilityRows& support, double instant,
+                                           std::optional<Eigen::VectorXd> near)
     : scenario_(scenario),
       model_(model),
       support_(support),
+      near_(std::move(near)),
       jointCount_(model.jointCount()),
       data_(model),
       derivatives_(model),
@@ -23,8 +25,10 @@ ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const Dynam
       zero_(Eigen::VectorXd::Zero(model.jointCount())),
       taskDq_(3, model.jointCount()),
       taskDv_(3, model.jointCount()) {
-  if (scenario.contactConstraints)
+  if (scenario.contactConstraints && !near_) {
+    supportRows_ = support.rowCount();
     for (int c = 0; c < support.rowCount(); ++c) rowTask_.push_back(-1), rowComponent_.push_back(c);
+  }
   for (std::size_t t = 0; t < scenario.tasks.size(); ++t) {
     const TaskSpec& task = scenario.tasks[t];
     if (taskReadsVelocity(task.kind)) continue;
@@ -73,8 +77,8 @@ void ConfigurationProblem::evaluate(const Eigen::VectorXd& q) {
   if (cacheValid_ && q == cachedQ_) return;
   inverseDynamicsDerivatives(model_, data_, derivatives_, q, zero_, zero_);
   int row = 0;
-  if (scenario_.contactConstraints) {
-    row = support_.rowCount();
+  if (supportRows_ > 0) {
+    row = supportRows_;
     support_.evaluate(data_.referenceWrench, rows_.head(row), rowsByWrench_);
     rowsByQ_.topRows(row).noalias() = rowsByWrench_ * derivatives_.dwrenchDq;
   }
@@ -94,6 +98,11 @@ void ConfigurationProblem::evaluate(const Eigen::VectorXd& q) {
 }
 
 double ConfigurationProblem::objective(const Eigen::VectorXd& q) {
+  if (near_) return 0.5 * (q - *near_).squaredNorm();
+  return staticPower(q);
+}
+
+double ConfigurationProblem::staticPower(const Eigen::VectorXd& q) {
   evaluate(q);
   double power = 0.0;
   for (int j = 0; j < jointCount_; ++j) {
@@ -105,6 +114,10 @@ double ConfigurationProblem::objective(const Eigen::VectorXd& q) {
 }
 
 void ConfigurationProblem::objectiveGradient(const Eigen::VectorXd& q, Eigen::VectorXd& gradient) {
+  if (near_) {
+    gradient = q - *near_;
+    return;
+  }
   evaluate(q);
   Eigen::VectorXd byTorque(jointCount_);
   for (int j = 0; j < jointCount_; ++j) {

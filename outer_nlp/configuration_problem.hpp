@@ -11,8 +11,14 @@
 // which is C¹ (its slope is continuous at |Γ/N| = Γ_d). Constraints: joint limits (bounds),
 // the support contact rows of W0 (contact_admissibility.hpp), position, orientation and
 // centre-of-mass tasks at that instant (velocity tasks are zero-velocity-free: ignored).
+//
+// With a `near` posture it is a reach instead: the posture closest to `near` (½‖q − near‖²)
+// that meets the tasks at that instant, without the support's rows — the posture the initial
+// motion passes through where a contact with a window holds (its closure one of those tasks:
+// the closing joints can then reach it; motion_problem.hpp).
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 #include "core/dynamics_derivatives.hpp"
@@ -27,7 +33,7 @@ class ConfigurationProblem final : public NlpProblem {
  public:
   /// instant: time of the posture in the motion [s] (0 for the start, T for the end).
   ConfigurationProblem(const Scenario& scenario, const DynamicsModel& model, const ContactAdmissibilityRows& support,
-                       double instant);
+                       double instant, std::optional<Eigen::VectorXd> near = std::nullopt);
 
   int variableCount() const override { return jointCount_; }
   int constraintCount() const override { return static_cast<int>(rowTask_.size()); }
@@ -41,8 +47,8 @@ class ConfigurationProblem final : public NlpProblem {
   void jacobianValues(const Eigen::VectorXd& q, Eigen::VectorXd& values) override;
   std::string rowName(int row) const override;
 
-  /// Static electrical power [W] (the objective).
-  double staticPower(const Eigen::VectorXd& q) { return objective(q); }
+  /// Static electrical power [W] (the objective without `near`).
+  double staticPower(const Eigen::VectorXd& q);
 
  private:
   void evaluate(const Eigen::VectorXd& q);
@@ -50,6 +56,8 @@ class ConfigurationProblem final : public NlpProblem {
   const Scenario& scenario_;
   const DynamicsModel& model_;
   const ContactAdmissibilityRows& support_;
+  std::optional<Eigen::VectorXd> near_;
+  int supportRows_ = 0;              ///< the support's rows first (none for a reach)
   int jointCount_;
   std::vector<int> tasks_;           ///< scenario tasks that hold at the instant
   std::vector<int> rowTask_;         ///< −1 for the contact rows, else the task

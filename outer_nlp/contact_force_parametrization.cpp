@@ -10,8 +10,9 @@ namespace mcopt {
 
 ContactForceParametrization::ContactForceParametrization(ContactForces kind,
                                                          const std::vector<std::array<double, 2>>& windows,
-                                                         const std::vector<double>& u, int controlPoints,
-                                                         int firstVariable)
+                                                         const std::vector<double>& u,
+                                                         const std::vector<std::vector<bool>>& active,
+                                                         int controlPoints, int firstVariable)
     : windows_(windows), firstVariable_(firstVariable) {
   if (kind == ContactForces::Bilevel) throw InputError("contact forces: the bilevel formulation has no force variables");
   const BSplineBasis basis(controlPoints);
@@ -22,7 +23,7 @@ ContactForceParametrization::ContactForceParametrization(ContactForces kind,
     auto& terms = terms_[i];
     terms.resize(u.size());
     for (std::size_t s = 0; s < u.size(); ++s) {
-      if (!insideWindow(u[s], window)) continue;
+      if (!active[i][s]) continue;
       if (kind == ContactForces::Variables) {
         terms[s].push_back({next, 1.0});
         next += 6;

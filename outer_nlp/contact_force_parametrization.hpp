@@ -23,10 +23,12 @@ class ContactForceParametrization {
     int variable = 0;  ///< global index of the term's f_x (f_y … m_z follow)
     double weight = 0.0;
   };
-  /// windows: per contact, the normalised window [u0, u1]; u: the normalised sample times.
-  /// firstVariable: global index of z's first entry.
+  /// windows: per contact, the normalised window [u0, u1]; u: the normalised sample times;
+  /// active: per contact and sample, in contact there (inside the window; at an instant sampled
+  /// twice, the twin on the window's side). firstVariable: global index of z's first entry.
   ContactForceParametrization(ContactForces kind, const std::vector<std::array<double, 2>>& windows,
-                              const std::vector<double>& u, int controlPoints, int firstVariable);
+                              const std::vector<double>& u, const std::vector<std::vector<bool>>& active,
+                              int controlPoints, int firstVariable);
 
   int contactCount() const { return static_cast<int>(windows_.size()); }
   int variableCount() const { return variableCount_; }

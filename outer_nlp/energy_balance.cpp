@@ -53,6 +53,10 @@ int energyGridInstants(const Scenario& scenario, int atLeast) {
   if (scenario.ball)  // the release sample, as MotionProblem places it
     marks.push_back(static_cast<double>(std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals)) /
                     intervals);
+  for (const EnvironmentContact& c : scenario.contacts)  // a window's ends (sampled twice)
+    if (c.window)
+      for (const double end : {c.start / scenario.duration.initial, c.end / scenario.duration.initial})
+        if (end > 0.0 && end < 1.0) marks.push_back(end);
   for (int k = atLeast; k <= 20 * atLeast; ++k) {
     const double instants = static_cast<double>(k) * intervals;
     const bool aligned = std::all_of(marks.begin(), marks.end(), [&](double u) {
@@ -130,21 +134,32 @@ EnergyBalance energyBalanceOf(const MotionProblem& fine, const SampledPhysics& p
       contactPower[s] += (pose.rotation * F.head<3>()).dot(twist.head<3>()) + (pose.rotation * F.tail<3>()).dot(twist.tail<3>());
     }
   }
-  // Composite Simpson over each run of the grid between instants of zero-length intervals (a
-  // throw's release instant, twice), the uniform instants taken in pairs, a trapezoid for an
-  // odd one left: its error falls as h⁴ where the motion is smooth (the spline's knots, where q̈
-  // has a kink, cost h² there alone).
+  // Composite Simpson between breakpoints: the instants sampled twice (a throw's release, a
+  // window's end: the power jumps there, each twin ends its side) and the regular instants of
+  // even index, where energyGridInstants puts the splines' knots (q̈ has a kink there). Between
+  // two breakpoints lie two intervals — Simpson's rule, for unequal intervals where a window's
+  // end falls between regular instants — or one, next to such an end (a trapezoid). The error
+  // then falls as h⁴ where the motion is smooth.
+  const int regular = scenario.samples;  // the fine grid's regular instants
+  std::vector<int> breakpoints;
+  for (int s = 0; s < M; ++s) {
+    const bool twin = (s > 0 && p.time[s] == p.time[s - 1]) || (s + 1 < M && p.time[s + 1] == p.time[s]);
+    const double index = p.time[s] / p.time[M - 1] * (regular - 1);
+    const bool even = std::abs(index - std::round(index)) <= 1e-6 && std::lround(index) % 2 == 0;
+    if (s == 0 || s == M - 1 || twin || even) breakpoints.push_back(s);
+  }
   auto integral = [&](const Eigen::VectorXd& f) {
     double sum = 0.0;
-    int begin = 0;
-    while (begin + 1 < M) {
-      int end = begin;
-      while (end + 1 < M && p.time[end + 1] > p.time[end]) ++end;
-      int s = begin;
-      for (; s + 2 <= end; s += 2)
-        sum += (p.time[s + 2] - p.time[s]) / 6.0 * (f[s] + 4.0 * f[s + 1] + f[s + 2]);
+    for (std::size_t k = 0; k + 1 < breakpoints.size(); ++k) {
+      int s = breakpoints[k];
+      const int end = breakpoints[k + 1];
+      for (; s + 2 <= end; s += 2) {
+        // Exact for quadratics on intervals h0, h1.
+        const double h0 = p.time[s + 1] - p.time[s], h1 = p.time[s + 2] - p.time[s + 1];
+        sum += (h0 + h1) / 6.0 *
+               ((2.0 - h1 / h0) * f[s] + (h0 + h1) * (h0 + h1) / (h0 * h1) * f[s + 1] + (2.0 - h0 / h1) * f[s + 2]);
+      }
       if (s < end) sum += 0.5 * (p.time[end] - p.time[s]) * (f[s] + f[end]);
-      begin = end + 1;
     }
     return sum;
   };

@@ -67,9 +67,11 @@ struct EnergyBalance {
 EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, int instantsPerInterval = 0);
 
 /// The least number of instants per sample interval, at least `atLeast`, that puts every knot of
-/// the splines (where q̈ has a kink) and a throw's release on an even instant of the grid, so that
-/// no Simpson pair straddles one: the integrals then converge as h⁴ (the kick: 12; the throws:
-/// 16). `atLeast` when no number up to 20 × atLeast does.
+/// the splines (where q̈ has a kink), a throw's release and a window's ends (where the power
+/// jumps) on an even instant of the grid, so that no Simpson pair straddles one: the integrals
+/// then converge as h⁴ (the kick: 12; the throws: 16; the lean reach: 32). `atLeast` when no
+/// number up to 20 × atLeast does (then a window's end between instants costs a trapezoid on
+/// each side).
 int energyGridInstants(const Scenario& scenario, int atLeast);
 
 /// The scenario on a grid of `instantsPerInterval` instants per interval of its samples, with no

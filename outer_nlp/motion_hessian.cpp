@@ -69,7 +69,7 @@ void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::
   outputGradient(b, h.weights, gradient);
   // The regularisation w Σ q̈² over the spline joints (formulation.md §10).
   for (int j = 0; j < n; ++j)
-    if (!closure_ || !closure_->closes(j)) gradient[2 * n + j] += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration[j];
+    if (!closure_ || !closure_->closesIn(j, b.closed)) gradient[2 * n + j] += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration[j];
 }
 
 void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights,
@@ -226,7 +226,7 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
     H(a, a) += M(2, 2);
   }
   for (int j = 0; j < n; ++j)
-    if (!closure_ || !closure_->closes(j)) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
+    if (!closure_ || !closure_->closesIn(j, b.closed)) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
   H.triangularView<Eigen::StrictlyUpper>() = H.transpose();  // the spreading reads the whole matrix
 }
 
@@ -316,7 +316,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // map on the closing ones): Tᵀ H T, and Tᵀ on the duration's row — the chain rule of the
     // gradient, the closure's own curvature left out (a Gauss–Newton term in the map).
     auto spread = [&](const LocalParameterWeights& weights, const Eigen::VectorXi& parameters, int stateBlocks,
-                      const std::vector<int>& forceColumns, LocalHessian& out, bool duration, const Eigen::MatrixXd* map) {
+                      const std::vector<int>& forceColumns, LocalHessian& out, bool duration, const Eigen::MatrixXd* map,
+                      ClosureSet closed) {
       const int k = weights.count, nf = static_cast<int>(forceColumns.size()), d = stateBlocks * n + nf;
       if (map) {
         const int c = outputs_.closing, sc = stateBlocks * c;
@@ -325,13 +326,21 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         auto Hfull = h.stateHessian.topLeftCorner(d, d);
         // The map's row g is closing joint g % c's in state block g / c.
         auto stateOf = [&](int g) { return (g / c) * n + closing[static_cast<std::size_t>(g % c)]; };
-        auto G = h.foldColumns.topLeftCorner(d, sc);  // H T: the closing columns through the map
-        for (int g = 0; g < sc; ++g) G.col(g) = Hfull.col(stateOf(g)), Hfull.col(stateOf(g)).setZero();
+        // (the map's rows of a joint not closed here are zero: its column and row stay)
+        auto isClosed = [&](int g) { return closure_->closesIn(closing[static_cast<std::size_t>(g % c)], closed); };
+        auto G = h.foldColumns.topLeftCorner(d, sc);  // H T: the closed columns through the map
+        for (int g = 0; g < sc; ++g) {
+          G.col(g).setZero();
+          if (isClosed(g)) G.col(g) = Hfull.col(stateOf(g)), Hfull.col(stateOf(g)).setZero();
+        }
         Hfull.leftCols(stateBlocks * n).noalias() += G * M;
-        auto R = h.foldRows.topLeftCorner(sc, d);  // Tᵀ (H T): the closing rows likewise
-        for (int g = 0; g < sc; ++g) R.row(g) = Hfull.row(stateOf(g)), Hfull.row(stateOf(g)).setZero();
+        auto R = h.foldRows.topLeftCorner(sc, d);  // Tᵀ (H T): the closed rows likewise
+        for (int g = 0; g < sc; ++g) {
+          R.row(g).setZero();
+          if (isClosed(g)) R.row(g) = Hfull.row(stateOf(g)), Hfull.row(stateOf(g)).setZero();
+        }
         Hfull.topRows(stateBlocks * n).noalias() += M.transpose() * R;
-        if (duration) foldGradient(*map, stateBlocks, h.durationRow.head(stateBlocks * n));
+        if (duration) foldGradient(*map, closed, stateBlocks, h.durationRow.head(stateBlocks * n));
       }
       const int local = n * k + nf;
       const double scale[3] = {1.0, 1.0 / T, 1.0 / (T * T)};
@@ -379,7 +388,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
         sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
-        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, closure_ ? &b.closureMap : nullptr);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, closure_ ? &b.closureMap : nullptr, b.closed);
         continue;
       }
       if (exact) {
@@ -401,7 +410,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           dz.segment(2 * n, n) -= 2.0 / T * g.segment(2 * n, n);
           dz += cE;
         }
-        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], freeDuration, closure_ ? &b.closureMap : nullptr);
+        spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], freeDuration, closure_ ? &b.closureMap : nullptr, b.closed);
         continue;
       }
       auto base = h.base.head(d), gradient = h.gradient.head(d);
@@ -411,12 +420,12 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       // Closed chains: differences in the spline joints' state, each probe closed again (the
       // closure's own curvature included), the gradients brought to that state by the map.
       if (closure_) {
-        foldGradient(b.closureMap, 3, base.head(3 * n));
+        foldGradient(b.closureMap, b.closed, 3, base.head(3 * n));
         h.closedState << w.q, w.v, w.a;
       }
       for (int c = 0; c < d; ++c) {
         const bool state = c < 3 * n;
-        if (closure_ && state && closure_->closes(c % n)) {
+        if (closure_ && state && closure_->closesIn(c % n, b.closed)) {
           h.stateHessian.col(c).head(d).setZero();
           continue;
         }
@@ -427,19 +436,19 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                                             : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
         const double saved = *component, step = differenceStep(saved);
         *component = saved + step;
-        if (closure_ && state) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap);
+        if (closure_ && state) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed);
         sampleOutputs(s, h.probeX, true, w, probe);
         *component = saved;
         if (closure_ && state) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
         sampleLagrangianGradient(probe, lambda, objectiveWeight, h, gradient);
-        if (closure_) foldGradient(state ? h.probeMap : b.closureMap, 3, gradient.head(3 * n));
+        if (closure_) foldGradient(state ? h.probeMap : b.closureMap, b.closed, 3, gradient.head(3 * n));
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       // A bilevel sample keeps its last inner solution (its warm start, its reported status):
       // leave it at the unperturbed state.
       if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
-      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, nullptr);
+      spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, nullptr, 0);
     }
 
 #pragma omp for schedule(static)
@@ -461,7 +470,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       closeState(b, w, nullptr);
       const int taskBlocks = velocity ? 2 : 1;
       if (closure_ && !exact) {  // as the samples': differences in the spline joints' state
-        foldGradient(b.closureMap, taskBlocks, base);
+        foldGradient(b.closureMap, b.closed, taskBlocks, base);
         h.closedState << w.q, w.v, w.a;
       }
       const bool durationTerms = exact && freeDuration && velocity;
@@ -503,19 +512,19 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
             h.stateHessian.col(c).head(d) = column;
           continue;
         }
-        if (closure_ && closure_->closes(c % n)) {
+        if (closure_ && closure_->closesIn(c % n, b.closed)) {
           h.stateHessian.col(c).head(d).setZero();
           continue;
         }
         const double step = differenceStep(saved);
         component = saved + step;
-        if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap);
+        if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed);
         taskOutputs(i, true, w, taskProbe);
         component = saved;
         if (closure_) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
         gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
         if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
-        if (closure_) foldGradient(h.probeMap, taskBlocks, gradient);
+        if (closure_) foldGradient(h.probeMap, b.closed, taskBlocks, gradient);
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }
       symmetrise(d);
@@ -528,7 +537,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         h.durationCurvature = u.dot(dz) - 2.0 / T * base.tail(n).dot(u.tail(n));
         dz.tail(n) -= base.tail(n) / T;
       }
-      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms, nullptr);
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms, nullptr, 0);
     }
   }
 

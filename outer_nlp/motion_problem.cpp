@@ -38,7 +38,7 @@ std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInst
   const double T = s.duration.initial;
   for (std::size_t t = 0; t < s.tasks.size(); ++t) {
     const TaskSpec& task = s.tasks[t];
-    if (task.heldThroughout) continue;  // held by construction (closed_chains.hpp)
+    if (task.heldByConstruction) continue;  // closed_chains.hpp
     if (!task.window) {
       u.push_back(std::min(1.0, task.start / T));
       taskOfInstant.push_back(static_cast<int>(t));
@@ -59,18 +59,51 @@ std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInst
   return u;
 }
 
-/// The regular samples u_s = s / (N − 1) and, with a thrown ball, the release sample twice:
-/// first loaded (the ball still in the hand), then released (formulation.md §10).
-std::vector<double> nlpSampleTimes(const Scenario& scenario) {
-  const int N = scenario.samples;
+/// The NLP's samples (formulation.md §10): the regular u_s = s / (N − 1) and, where the physics
+/// jumps, the instant twice, each side its own sample — a thrown ball's release (on the nearest
+/// regular sample: loaded, then released) and each end of a contact's window inside the motion
+/// (out of contact then in at its start, in then out at its end; inserted where no regular
+/// sample is). `side`: −1 the twin before the instant, +1 after, 0 a single sample.
+struct NlpSampleGrid {
   std::vector<double> u;
-  for (int s = 0; s < N; ++s) u.push_back(static_cast<double>(s) / (N - 1));
+  std::vector<int> side;
+  int releaseSample = -1;  ///< the loaded twin
+};
+
+NlpSampleGrid nlpSampleGrid(const Scenario& scenario) {
+  const int N = scenario.samples;
+  const double T = scenario.duration.initial, slack = 1e-9;
+  std::vector<double> jumps;  // instants where the physics jumps
+  double release = -1.0;
   if (scenario.ball) {
-    const auto release = static_cast<std::size_t>(std::lround(scenario.ball->releaseTime / scenario.duration.initial * (N - 1)));
-    u.insert(u.begin() + static_cast<std::ptrdiff_t>(release), u[release]);
+    release = static_cast<double>(std::lround(scenario.ball->releaseTime / T * (N - 1))) / (N - 1);
+    jumps.push_back(release);
   }
-  return u;
+  for (const EnvironmentContact& c : scenario.contacts)
+    if (c.window)
+      for (const double end : {c.start / T, std::min(1.0, c.end / T)})
+        if (end > slack && end < 1.0 - slack) jumps.push_back(end);
+  std::sort(jumps.begin(), jumps.end());
+  NlpSampleGrid grid;
+  auto add = [&](double u, int side) { grid.u.push_back(u), grid.side.push_back(side); };
+  std::size_t next = 0;
+  for (int k = 0; k < N; ++k) {
+    const double u = static_cast<double>(k) / (N - 1);
+    bool regularIsJump = false;
+    while (next < jumps.size() && jumps[next] < u + slack) {
+      const double jump = jumps[next];
+      while (next < jumps.size() && jumps[next] < jump + slack) ++next;  // one pair for coinciding jumps
+      regularIsJump = std::abs(jump - u) <= slack;
+      const double at = regularIsJump ? u : jump;
+      if (std::abs(at - release) <= slack) grid.releaseSample = static_cast<int>(grid.u.size());
+      add(at, -1), add(at, +1);
+    }
+    if (!regularIsJump) add(u, 0);
+  }
+  return grid;
 }
+
+std::vector<double> nlpSampleTimes(const Scenario& scenario) { return nlpSampleGrid(scenario).u; }
 
 /// The support contact is on the reference body: its frame never moves.
 RigidTransform supportPose(const DynamicsModel& model, const ContactSurface& surface) {
@@ -145,29 +178,35 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   }
   jointCount_ = model_.jointCount();
   parameterCount_ = parametrization_.parameterCount();
-  // Contacts held over the whole motion: closed by construction (closed_chains.hpp).
+  // Environment contacts: closed by construction over their windows (closed_chains.hpp; the
+  // exact Hessian option refuses them: exactHessianRefusal, checked above).
   std::vector<HeldContact> held;
-  for (const EnvironmentContact& c : scenario_.contacts)
-    if (!c.window) held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose});
-  // (the exact Hessian option refuses them: exactHessianRefusal, checked above)
+  for (const EnvironmentContact& c : scenario_.contacts) {
+    HeldContact h{c.surface.name, c.surface.frame, c.surface.placement, c.worldPose};
+    if (c.window) h.window = {c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)};
+    held.push_back(h);
+  }
   if (!held.empty()) closure_ = std::make_unique<ClosedChains>(model_, std::move(held), scenario_.start);
   const int closing = closure_ ? closure_->closingCount() : 0;
   outputs_.closing = closing;
-  // Trapezoid weights as fractions of T: c_s / (N − 1), halved at the ends and, with a ball,
-  // at the release's two samples (the power jumps there; each side takes its half interval).
-  sampleTimes_ = nlpSampleTimes(scenario_);
+  // Trapezoid weights as fractions of T, (u_{s+1} − u_{s−1}) / 2: 1 / (N − 1) between regular
+  // samples, halved at the ends and, where an instant is sampled twice (a throw's release, a
+  // window's end: the power jumps there), each twin its side's half interval.
+  const NlpSampleGrid grid = nlpSampleGrid(scenario_);
+  sampleTimes_ = grid.u;
+  sampleSides_ = grid.side;
   const int count = samples_.sampleCount();
-  sampleWeights_.assign(static_cast<std::size_t>(count), 1.0 / (scenario_.samples - 1));
-  sampleWeights_.front() *= 0.5, sampleWeights_.back() *= 0.5;
+  sampleWeights_.assign(static_cast<std::size_t>(count), 0.0);
+  for (int s = 0; s < count; ++s)
+    sampleWeights_[static_cast<std::size_t>(s)] =
+        0.5 * (sampleTimes_[static_cast<std::size_t>(std::min(s + 1, count - 1))] - sampleTimes_[static_cast<std::size_t>(std::max(s - 1, 0))]);
   loaded_.assign(static_cast<std::size_t>(count), false);
   if (scenario_.ball) {
     const ThrownBall& ball = *scenario_.ball;
     loadedModel_ = std::make_unique<DynamicsModel>(withPointMass(scenario.robot, ball.frame, ball.point, ball.mass),
                                                    scenario.referenceBody, scenario.referencePose, scenario.gravity);
-    releaseSample_ = static_cast<int>(std::lround(ball.releaseTime / scenario_.duration.initial * (scenario_.samples - 1)));
+    releaseSample_ = grid.releaseSample;
     for (int s = 0; s <= releaseSample_; ++s) loaded_[static_cast<std::size_t>(s)] = true;
-    sampleWeights_[static_cast<std::size_t>(releaseSample_)] *= 0.5;
-    sampleWeights_[static_cast<std::size_t>(releaseSample_) + 1] *= 0.5;
   }
   omittedTorqueRows_ = std::move(omittedTorqueRows);
   if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
@@ -177,13 +216,24 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   forceStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
   for (const EnvironmentContact& c : scenario_.contacts) {
     windows_.push_back({c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)});
+    // In contact at a sample inside the window; at a twin of a window's end, on the side within it.
+    const std::array<double, 2>& w = windows_.back();
+    std::vector<bool> active(static_cast<std::size_t>(count));
+    for (int s = 0; s < count; ++s) {
+      const double u = sampleTimes_[static_cast<std::size_t>(s)];
+      const int side = sampleSides_[static_cast<std::size_t>(s)];
+      active[static_cast<std::size_t>(s)] = side < 0   ? u > w[0] + 1e-9 && u <= w[1] + 1e-9
+                                            : side > 0 ? u >= w[0] - 1e-9 && u < w[1] - 1e-9
+                                                       : insideWindow(u, w);
+    }
+    active_.push_back(std::move(active));
     contactRows_.emplace_back(c.surface, RigidTransform{}, weight_, scenario_.inner.problem);
   }
   // With the reference contact alone the wrench is W0 whatever the formulation (§5).
   bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
   if (contacts > 0 && !bilevel_)
     forces_ = std::make_unique<ContactForceParametrization>(scenario_.contactForces, windows_,
-                                                            sampleTimes_, scenario_.forceControlPoints,
+                                                            sampleTimes_, active_, scenario_.forceControlPoints,
                                                             forceStart_);
   slackStart_ = forceStart_ + forceVariableCount();
   variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * count : 0);
@@ -200,7 +250,9 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   const int m = parametrization_.parametersPerJoint();
   for (int j = 0; j < jointCount_ && scenario_.velocityLimits; ++j) {
     if (!std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].velocityLimit)) continue;
-    if (closure_ && closure_->closes(j)) continue;  // its limit is a row at every sample
+    // A whole-motion contact's closing joint: its limit is a row at every sample (a window's
+    // keeps its spline's rows for the instants outside it, and rows at the samples inside).
+    if (closure_ && closure_->closes(j) && closure_->wholeMotion(closure_->contactOf(j))) continue;
     for (int k = 0; k + 1 < parametrization_.controlPointCount(); ++k) {
       const int first = parametrization_.parameterOfControlPoint(k), second = parametrization_.parameterOfControlPoint(k + 1);
       if (first == second) continue;  // the clamped ends: identically zero
@@ -227,6 +279,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
     b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
+    // The contacts in contact here are closed (a window's end sampled once or on its side within).
+    for (int i = 0; closure_ && i < contacts; ++i)
+      if (contactActive(i, s)) b.closed |= ClosureSet{1} << i;
+    b.startFromSplines = sampleSides_[static_cast<std::size_t>(s)] != 0;
     // Local parameters of every sample (the chain rule's column order), fixed for good.
     samples_.chainRule(s, 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
@@ -237,6 +293,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     b.dyDq.setZero(3, jointCount_), b.dyDv.setZero(3, jointCount_), b.dyDa.setZero(3, jointCount_);
     b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
+    // At a window's end the task reads the splines' state: there they meet the closure.
+    if (closure_) b.closed = closure_->closedAt(taskSamples_.time(static_cast<int>(i), 1.0), false);
     taskSamples_.chainRule(static_cast<int>(i), 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
   // Sparsity within a sample: with forces fixed by the formulation's variables, Γ_i (and
@@ -263,13 +321,32 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       if (model_.supports(j, model_.framePosition(task.frame))) path.push_back(j);
     taskJoints_.push_back(path);
   }
+  // A spline parameter is used when it reaches a sample or task instant where its joint is a
+  // spline (every parameter of a joint closing nothing; a window's closing joint outside it).
+  unusedParameter_.assign(static_cast<std::size_t>(parameterCount_), false);
+  if (closure_) {
+    std::vector<bool> used(static_cast<std::size_t>(parameterCount_), false);
+    auto mark = [&](const SampledTrajectory& trajectory, const std::vector<SampleBlock>& blocks) {
+      for (std::size_t s = 0; s < blocks.size(); ++s) {
+        const LocalParameterWeights& local = trajectory.weights(static_cast<int>(s));
+        for (int j = 0; j < jointCount_; ++j)
+          if (!closure_->closesIn(j, blocks[s].closed))
+            for (int l = 0; l < local.count; ++l) used[static_cast<std::size_t>(j * m + local.parameter[static_cast<std::size_t>(l)])] = true;
+      }
+    };
+    mark(samples_, blocks_);
+    mark(taskSamples_, taskBlocks_);
+    for (int j = 0; j < jointCount_; ++j)
+      for (int l = 0; l < m && closure_->closes(j); ++l)
+        unusedParameter_[static_cast<std::size_t>(j * m + l)] = !used[static_cast<std::size_t>(j * m + l)];
+  }
   buildStructure();
 }
 
 MotionProblem::~MotionProblem() = default;
 
 bool MotionProblem::contactActive(int contact, int sample) const {
-  return insideWindow(sampleTimes_[static_cast<std::size_t>(sample)], windows_[static_cast<std::size_t>(contact)]);
+  return active_[static_cast<std::size_t>(contact)][static_cast<std::size_t>(sample)];
 }
 
 std::vector<ContactSurface> MotionProblem::surfacesInContact(int sample) const {
@@ -371,6 +448,7 @@ void MotionProblem::buildStructure() {
       sampleRow(ConstraintKind::InnerFeasibility, 0, false, s, outputs_.infeasibility(), 1.0, allJoints_, false);
     for (int k = 0; k < outputs_.closing; ++k) {
       const int joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
+      if (!closure_->closesIn(joint, blocks_[static_cast<std::size_t>(s)].closed)) continue;  // a spline here: its control points' bounds
       if (scenario_.positionLimits)
         sampleRow(ConstraintKind::ClosingJointLimit, k, false, s, outputs_.closingPosition(k), 1.0, allJoints_, false);
       if (scenario_.velocityLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit))
@@ -454,9 +532,10 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
       lower[end] = upper[end] = scenario_.end[j];
     }
   }
-  // A closing joint follows the closure: its spline parameters are unused, fixed at the start posture.
+  // Where a closing joint follows the closure its spline parameters are unused: fixed at the start posture.
   for (int j = 0; closure_ && j < jointCount_; ++j)
-    if (closure_->closes(j)) lower.segment(j * m, m).setConstant(scenario_.start[j]), upper.segment(j * m, m).setConstant(scenario_.start[j]);
+    for (int l = 0; l < m; ++l)
+      if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) lower[j * m + l] = upper[j * m + l] = scenario_.start[j];
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
   lower.tail(variableCount_ - slackStart_).setZero();
 }
@@ -508,6 +587,56 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
   return pointFromMotion(parametrization_.interpolatedMotion(start, end), scenario_.duration.initial);
 }
 
+Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end,
+                                            const std::vector<HeldPosture>& held) {
+  if (held.empty()) return initialPoint(start, end);
+  // The path's corners: (0, start), each held posture at its two ends, (1, end).
+  std::vector<std::pair<double, Eigen::VectorXd>> corners{{0.0, start}};
+  std::vector<HeldPosture> sorted = held;
+  std::sort(sorted.begin(), sorted.end(), [](const HeldPosture& a, const HeldPosture& b) { return a.begin < b.begin; });
+  for (const HeldPosture& h : sorted) {
+    if (h.posture.size() != jointCount_) throw std::invalid_argument("initialPoint: a held posture of the wrong size");
+    corners.emplace_back(std::max(h.begin, corners.back().first), h.posture);
+    corners.emplace_back(std::max(h.end, corners.back().first), h.posture);
+  }
+  corners.emplace_back(1.0, parametrization_.periodic() ? start : end);
+  const int G = 20 * parametrization_.controlPointCount(), m = parametrization_.parametersPerJoint();
+  std::vector<double> times;
+  for (int g = 0; g < G; ++g) times.push_back(static_cast<double>(g) / (G - 1));
+  const SampledTrajectory grid(parametrization_, times);
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(G, m);
+  for (int g = 0; g < G; ++g) {
+    const LocalParameterWeights& local = grid.weights(g);
+    for (int l = 0; l < local.count; ++l) basis(g, local.parameter[static_cast<std::size_t>(l)]) += local.value[static_cast<std::size_t>(l)];
+  }
+  // The end parameters stay at start and end (the interpolation's): the others fitted.
+  Eigen::VectorXd parameters = parametrization_.interpolatedMotion(start, end);
+  std::vector<int> fixed{0};
+  if (!parametrization_.periodic()) fixed.push_back(parametrization_.endParameter());
+  std::vector<int> free;
+  for (int l = 0; l < m; ++l)
+    if (std::find(fixed.begin(), fixed.end(), l) == fixed.end()) free.push_back(l);
+  Eigen::MatrixXd A(G, static_cast<Eigen::Index>(free.size()));
+  for (std::size_t f = 0; f < free.size(); ++f) A.col(static_cast<Eigen::Index>(f)) = basis.col(free[f]);
+  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
+  Eigen::VectorXd target(G);
+  for (int j = 0; j < jointCount_; ++j) {
+    for (int g = 0; g < G; ++g) {
+      const double u = times[static_cast<std::size_t>(g)];
+      std::size_t k = 1;
+      while (k + 1 < corners.size() && corners[k].first < u) ++k;
+      const auto& [u0, q0] = corners[k - 1];
+      const auto& [u1, q1] = corners[k];
+      const double t = u1 > u0 ? std::clamp((u - u0) / (u1 - u0), 0.0, 1.0) : 1.0;
+      target[g] = (1.0 - t) * q0[j] + t * q1[j];
+      for (const int l : fixed) target[g] -= basis(g, l) * parameters[j * m + l];
+    }
+    const Eigen::VectorXd fitted = qr.solve(target);
+    for (std::size_t f = 0; f < free.size(); ++f) parameters[j * m + free[f]] = fitted[static_cast<Eigen::Index>(f)];
+  }
+  return pointFromMotion(parameters, scenario_.duration.initial);
+}
+
 Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionParameters, double T) {
   if (motionParameters.size() != parameterCount_)
     throw std::invalid_argument("pointFromMotion: " + std::to_string(motionParameters.size()) + " spline parameters for " +
@@ -516,7 +645,8 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
   x.head(parameterCount_) = motionParameters;
   const int m = parametrization_.parametersPerJoint();
   for (int j = 0; closure_ && j < jointCount_; ++j)
-    if (closure_->closes(j)) x.segment(j * m, m).setConstant(scenario_.start[j]);  // unused (variableBounds)
+    for (int l = 0; l < m; ++l)
+      if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) x[j * m + l] = scenario_.start[j];  // (variableBounds)
   if (durationIsFree()) x[parameterCount_] = T;
   if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
@@ -525,13 +655,14 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
     ThreadWorkspace& w = workspaces_.front();
     Eigen::MatrixXd controlPoints;
     parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
+    if (closure_ && !closureStarted_) startClosureAlongTheMotion(controlPoints, duration(x));
     std::unique_ptr<BilevelSample> previous;
     for (int s = 0; s < samples_.sampleCount(); ++s) {
       std::vector<int> which;
       for (int i = 0; i < outputs_.contacts; ++i)
         if (contactActive(i, s)) which.push_back(i);
       samples_.evaluate(s, controlPoints, duration(x), w.q, w.v, w.a);
-      if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr);
+      closeState(blocks_[static_cast<std::size_t>(s)], w, nullptr);
       inverseDynamics(modelOf(s), w.data, w.q, w.v, w.a);
       auto sample =
           std::make_unique<BilevelSample>(modelOf(s), surfacesInContact(s), scenario_.inner, scenario_.sensitivity, weight_);
@@ -569,24 +700,26 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
     y.segment(forceStart_, forceVariableCount()) = x.segment(other.forceStart_, other.forceVariableCount());
   } else {
     // Piecewise linear in time through other's samples, within the carried and the released
-    // parts of a throw apart (the release instant is a sample of both grids, twice).
+    // parts of a throw apart (the release instant is a sample of both grids, twice), and on the
+    // same side of an instant sampled twice (a window's end: each side its own wrench).
     other.evaluate(x, false);
     const int M = other.samples_.sampleCount(), N = samples_.sampleCount();
     std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, N));
+    auto order = [](double u, int side) { return u + 1e-11 * side; };  // a twin just before or after its instant
     for (int s = 0; s < N; ++s) {
-      const double u = sampleTimes_[static_cast<std::size_t>(s)];
+      const double u = order(sampleTimes_[static_cast<std::size_t>(s)], sampleSides_[static_cast<std::size_t>(s)]);
       const bool carried = loaded_[static_cast<std::size_t>(s)];
       int before = -1, after = -1;
       for (int k = 0; k < M; ++k) {
         if (other.loaded_[static_cast<std::size_t>(k)] != carried) continue;
-        const double uk = other.sampleTimes_[static_cast<std::size_t>(k)];
+        const double uk = order(other.sampleTimes_[static_cast<std::size_t>(k)], other.sampleSides_[static_cast<std::size_t>(k)]);
         if (uk <= u + 1e-12) before = k;
         if (uk >= u - 1e-12 && after < 0) after = k;
       }
       if (before < 0) before = after;
       if (after < 0) after = before;
       const double u0 = other.sampleTimes_[static_cast<std::size_t>(before)], u1 = other.sampleTimes_[static_cast<std::size_t>(after)];
-      const double t = u1 > u0 ? (u - u0) / (u1 - u0) : 0.0;
+      const double t = u1 > u0 ? (sampleTimes_[static_cast<std::size_t>(s)] - u0) / (u1 - u0) : 0.0;
       const SampleBlock& b0 = other.blocks_[static_cast<std::size_t>(before)];
       const SampleBlock& b1 = other.blocks_[static_cast<std::size_t>(after)];
       for (std::size_t i = 0; i < scenario_.contacts.size(); ++i) {
@@ -603,14 +736,56 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
 bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const {
   if (!closure_) return true;
   // Newton from the angles reached last at this instant: the same closure, in one or two steps.
-  for (int k = 0; k < outputs_.closing; ++k)
-    if (std::isfinite(b.closedAngles[k])) w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]] = b.closedAngles[k];
-  return closure_->close(model_, w.closure, w.q, w.v, w.a, map);
+  for (int k = 0; k < outputs_.closing && !b.startFromSplines; ++k) {
+    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+    if (std::isfinite(b.closedAngles[k]) && closure_->closesIn(j, b.closed)) w.q[j] = b.closedAngles[k];
+  }
+  return closure_->close(model_, w.closure, w.q, w.v, w.a, map, b.closed);
+}
+
+void MotionProblem::startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoints, double T) {
+  ThreadWorkspace& w = workspaces_.front();
+  const std::vector<int>& closing = closure_->closingJoints();
+  for (std::size_t s = 0; s < blocks_.size(); ++s) {
+    SampleBlock& b = blocks_[s];
+    samples_.evaluate(static_cast<int>(s), controlPoints, T, w.q, w.v, w.a);
+    for (int k = 0; k < outputs_.closing && s > 0; ++k) {
+      const int j = closing[static_cast<std::size_t>(k)];
+      if (closure_->closesIn(j, b.closed) && closure_->closesIn(j, blocks_[s - 1].closed) && !b.startFromSplines &&
+          std::isfinite(blocks_[s - 1].closedAngles[k]))
+        w.q[j] = blocks_[s - 1].closedAngles[k];
+    }
+    closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr, b.closed);
+    for (int k = 0; k < outputs_.closing; ++k) {
+      const int j = closing[static_cast<std::size_t>(k)];
+      b.closedAngles[k] = closure_->closesIn(j, b.closed) ? w.q[j] : std::numeric_limits<double>::quiet_NaN();
+    }
+  }
+  startTaskClosures();
+  closureStarted_ = true;
+}
+
+void MotionProblem::startTaskClosures() {
+  for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
+    SampleBlock& t = taskBlocks_[i];
+    const double u = taskSamples_.time(static_cast<int>(i), 1.0);
+    for (int k = 0; k < outputs_.closing; ++k) {
+      double nearest = std::numeric_limits<double>::infinity();
+      t.closedAngles[k] = std::numeric_limits<double>::quiet_NaN();
+      for (std::size_t s = 0; s < blocks_.size(); ++s) {
+        const double distance = std::abs(sampleTimes_[s] - u);
+        if (std::isfinite(blocks_[s].closedAngles[k]) && distance < nearest) nearest = distance, t.closedAngles[k] = blocks_[s].closedAngles[k];
+      }
+    }
+  }
 }
 
 void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives) {
   if (!closure_ || !closeState(b, w, derivatives ? &b.closureMap : nullptr)) return;
-  for (int k = 0; k < outputs_.closing; ++k) b.closedAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+  for (int k = 0; k < outputs_.closing; ++k) {
+    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+    if (closure_->closesIn(j, b.closed)) b.closedAngles[k] = w.q[j];
+  }
 }
 
 void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
@@ -626,14 +801,17 @@ void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, E
   dq.noalias() += gather * b.closureMap.leftCols(n);
   dv.noalias() += gather * b.closureMap.middleCols(n, n);
   da.noalias() += gather * b.closureMap.rightCols(n);
-  for (const int j : closing) dq.col(j).setZero(), dv.col(j).setZero(), da.col(j).setZero();
+  for (const int j : closing)
+    if (closure_->closesIn(j, b.closed)) dq.col(j).setZero(), dv.col(j).setZero(), da.col(j).setZero();
 }
 
-void MotionProblem::foldGradient(const Eigen::MatrixXd& map, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const {
+void MotionProblem::foldGradient(const Eigen::MatrixXd& map, ClosureSet closed, int stateBlocks,
+                                 Eigen::Ref<Eigen::VectorXd> gradient) const {
   const int c = outputs_.closing, n = jointCount_;
   const std::vector<int>& closing = closure_->closingJoints();
   for (int block = 0; block < stateBlocks; ++block)
     for (int k = 0; k < c; ++k) {
+      if (!closure_->closesIn(closing[static_cast<std::size_t>(k)], closed)) continue;
       const int at = block * n + closing[static_cast<std::size_t>(k)];
       const double g = gradient[at];
       gradient[at] = 0.0;
@@ -666,6 +844,8 @@ Eigen::MatrixXd MotionProblem::closureAngles() const {
 void MotionProblem::startClosureAt(const Eigen::MatrixXd& angles) {
   if (!closure_ || angles.rows() != outputs_.closing || angles.cols() != static_cast<Eigen::Index>(blocks_.size())) return;
   for (std::size_t s = 0; s < blocks_.size(); ++s) blocks_[s].closedAngles = angles.col(static_cast<Eigen::Index>(s));
+  startTaskClosures();
+  closureStarted_ = true;
   cacheValid_ = false;
 }
 
@@ -679,12 +859,31 @@ Eigen::VectorXd MotionProblem::reportedMotionParameters(const Eigen::VectorXd& x
     const LocalParameterWeights& local = samples_.weights(s);
     for (int l = 0; l < local.count; ++l) basis(s, local.parameter[static_cast<std::size_t>(l)]) += local.value[static_cast<std::size_t>(l)];
   }
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(basis);
-  Eigen::VectorXd angles(N);
+  // Per closing joint: its unused parameters fitted, least squares, to the closure's angles at
+  // the samples where it is closed, the used ones (its spline outside a window) kept.
   for (int k = 0; k < outputs_.closing; ++k) {
     const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-    for (int s = 0; s < N; ++s) angles[s] = blocks_[static_cast<std::size_t>(s)].y[outputs_.closingPosition(k)];
-    parameters.segment(j * m, m) = qr.solve(angles);
+    std::vector<int> rows, free;
+    for (int s = 0; s < N; ++s)
+      if (closure_->closesIn(j, blocks_[static_cast<std::size_t>(s)].closed)) rows.push_back(s);
+    for (int l = 0; l < m; ++l)
+      if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) free.push_back(l);
+    if (rows.empty() || free.empty()) continue;
+    Eigen::MatrixXd A(rows.size(), free.size());
+    Eigen::VectorXd residual(rows.size());
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+      const int s = rows[r];
+      residual[static_cast<Eigen::Index>(r)] = blocks_[static_cast<std::size_t>(s)].y[outputs_.closingPosition(k)];
+      for (int l = 0; l < m; ++l) {
+        const auto at = std::find(free.begin(), free.end(), l);
+        if (at == free.end())
+          residual[static_cast<Eigen::Index>(r)] -= basis(s, l) * parameters[j * m + l];
+        else
+          A(static_cast<Eigen::Index>(r), at - free.begin()) = basis(s, l);
+      }
+    }
+    const Eigen::VectorXd fitted = A.colPivHouseholderQr().solve(residual);
+    for (std::size_t f = 0; f < free.size(); ++f) parameters[j * m + free[f]] = fitted[static_cast<Eigen::Index>(f)];
   }
   return parameters;
 }
@@ -842,6 +1041,7 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   if (!x.allFinite()) throw InputError("motion problem: non-finite variables");
   const double T = duration(x);
   parametrization_.controlPoints(x.head(parameterCount_), controlPoints_);
+  if (closure_ && !closureStarted_) startClosureAlongTheMotion(controlPoints_, T);
   const int count = samples_.sampleCount(), taskCount = static_cast<int>(taskBlocks_.size());
   const int threads = static_cast<int>(workspaces_.size());
   // Fixed chunks of consecutive samples, each evaluated in order by one thread: a bilevel
@@ -889,8 +1089,8 @@ double MotionProblem::objective(const Eigen::VectorXd& x) {
       for (int j = 0; j < n; ++j)
         sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)], scenario_.smoothing);
     if (scenario_.accelerationWeight > 0.0)
-      for (int j = 0; j < n; ++j)  // the spline joints' (a closing joint's follows the closure)
-        if (!closure_ || !closure_->closes(j))
+      for (int j = 0; j < n; ++j)  // the spline joints' (a closed joint's follows the closure)
+        if (!closure_ || !closure_->closesIn(j, blocks_[static_cast<std::size_t>(s)].closed))
           sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration[j] * blocks_[static_cast<std::size_t>(s)].acceleration[j];
     energy += weight * sum;
   }
@@ -917,7 +1117,7 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
       const int m = parametrization_.parametersPerJoint();
       double squared = 0.0;
       for (int j = 0; j < n; ++j) {
-        if (closure_ && closure_->closes(j)) continue;
+        if (closure_ && closure_->closesIn(j, b.closed)) continue;
         squared += b.acceleration[j] * b.acceleration[j];
         for (int l = 0; l < local.count; ++l)
           gradient[j * m + local.parameter[l]] += scale * 2.0 * b.acceleration[j] * local.d2[l] / (T * T);
@@ -1020,7 +1220,7 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   atRelease.evaluate(0, controlPoints, T, q, v, a);
   if (closure_) {
     ClosedChainData closing(model_, closure_->contactCount());
-    closure_->close(model_, closing, q, v, a, nullptr);
+    closure_->close(model_, closing, q, v, a, nullptr, closure_->closedAt(sampleTimes_[static_cast<std::size_t>(releaseSample_)], true));
   }
   DynamicsData data(model_);
   inverseDynamics(model_, data, q, v, a);  // the bodies' poses and twists
@@ -1096,19 +1296,36 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
     p.fineTime = fineResult.time, p.finePower = fineResult.power, p.fineEnergy = fineResult.energy;
   }
   // Closure drift between the samples: the contact frames on a fine grid, the scenario's output
-  // samples or 10 instants per sample interval, whichever is finer: how far each frame strays
-  // from its world pose and how fast it slides there.
-  const SampledTrajectory fine(parametrization_, std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1));
+  // samples or 10 instants per sample interval, whichever is finer, and each window's ends, read
+  // from the splines there (where they meet the closure): how far each frame strays from its
+  // world pose and how fast it slides.
+  const int fineCount = std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1);
+  std::vector<std::pair<double, bool>> instants;  // u, at a window's end
+  for (int s = 0; s < fineCount; ++s) instants.emplace_back(static_cast<double>(s) / (fineCount - 1), false);
+  for (const std::array<double, 2>& window : windows_)
+    for (const double end : window)
+      if (end > 0.0 && end < 1.0) instants.emplace_back(end, true);
+  std::sort(instants.begin(), instants.end());
+  std::vector<double> fineTimes;
+  for (const auto& instant : instants) fineTimes.push_back(instant.first);
+  const SampledTrajectory fine(parametrization_, fineTimes);
   for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
     drift->assign(static_cast<std::size_t>(contacts), 0.0);
   Eigen::VectorXd previousAngles = closure_ ? Eigen::VectorXd(blocks_.front().closedAngles) : Eigen::VectorXd();
   for (int s = 0; s < fine.sampleCount(); ++s) {
-    const double u = static_cast<double>(s) / (fine.sampleCount() - 1);
+    const double u = instants[static_cast<std::size_t>(s)].first;
     fine.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
-    if (closure_) {  // Newton from the previous fine instant's closing angles (the first: the first sample's)
-      for (int k = 0; k < outputs_.closing; ++k) w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]] = previousAngles[k];
-      closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr);
-      for (int k = 0; k < outputs_.closing; ++k) previousAngles[k] = w.q[closure_->closingJoints()[static_cast<std::size_t>(k)]];
+    if (closure_) {  // Newton from the previous closed instant's angles (the first: the first sample's)
+      const ClosureSet closed = closure_->closedAt(u, !instants[static_cast<std::size_t>(s)].second);
+      for (int k = 0; k < outputs_.closing; ++k) {
+        const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+        if (closure_->closesIn(j, closed) && std::isfinite(previousAngles[k])) w.q[j] = previousAngles[k];
+      }
+      closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr, closed);
+      for (int k = 0; k < outputs_.closing; ++k) {
+        const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+        if (closure_->closesIn(j, closed)) previousAngles[k] = w.q[j];
+      }
     }
     inverseDynamics(model_, w.data, w.q, w.v, w.a);  // the poses and the twists
     for (int i = 0; i < contacts; ++i) {

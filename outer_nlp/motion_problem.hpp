@@ -28,14 +28,17 @@
 //      (μ² f_z² − f_x² − f_y²)/(m g)² ≥ 0, the centre of pressure in the rectangle written
 //      linearly; bilevel: the inner problem's infeasibility φ = ‖slack‖²/(m g)² ≤ 0 (the
 //      inner problem holds the contacts' own rows); with the epigraph form s_js − P_js ≥ 0;
-//   3. task rows: per task, per instant, per bounded component; a contact's closure over a
-//      window (its frame at its world pose there) is a pair of such tasks;
-//   4. per sample, the position and velocity limits of the joints that close a contact held
-//      over the whole motion (closed_chains.hpp): those joints follow the closure, not splines.
-// A contact held over the whole motion holds by construction: at every instant its loop's six
-// closing joints are the closure's (closed_chains.hpp), and every output's derivative goes
-// through them (the chain rule by the implicit function theorem); their spline parameters are
-// fixed at the start posture and unused.
+//   3. task rows: per task, per instant, per bounded component; at each end of a contact's
+//      window inside the motion, its frame at its world pose and at rest (position,
+//      orientation, linear and angular velocity: twelve equality rows), where the splines of its
+//      closing joints meet the closure (each end is sampled twice, out of contact and in);
+//   4. per sample, the position and velocity limits of the joints that close a contact active
+//      there (closed_chains.hpp): those joints follow the closure, not splines.
+// Every environment contact holds by construction: at every instant of its window (the whole
+// motion, or its own) its loop's six closing joints are the closure's (closed_chains.hpp), and
+// every output's derivative goes through them (the chain rule by the implicit function
+// theorem); the spline parameters that reach no instant outside the window are fixed at the
+// start posture and unused.
 // Sample rows depend only on the ≤ 4 local parameters of the joints that move them (+ T,
 // + the sample's force variables, + a slack), which is the declared sparsity.
 //
@@ -177,6 +180,16 @@ class MotionProblem final : public NlpProblem {
   /// duration, force variables fitted to the inner problem's wrenches along that motion
   /// (splines, variables), and epigraph slacks at max(P, 0) of that motion.
   Eigen::VectorXd initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end);
+  /// A posture held over [begin, end] (fractions of T) by the initial motion.
+  struct HeldPosture {
+    double begin = 0.0, end = 1.0;
+    Eigen::VectorXd posture;
+  };
+  /// The same through postures held over parts of the motion (a window's contact posture,
+  /// where its closing joints can reach it): the splines fitted, least squares on a fine grid,
+  /// to the path from `start` through each held posture to `end` (linear between them), their
+  /// end parameters at `start` and `end`.
+  Eigen::VectorXd initialPoint(const Eigen::VectorXd& start, const Eigen::VectorXd& end, const std::vector<HeldPosture>& held);
   /// The same from a given motion (spline parameters, duration T): a result's motion as the
   /// start of another formulation — the bilevel optimum's forces are then a feasible point of
   /// the single-level ones (formulation.md §9).
@@ -232,6 +245,8 @@ class MotionProblem final : public NlpProblem {
   /// The NLP's samples: the scenario's N, and with a ball the release sample twice (loaded,
   /// then released). Normalised times and trapezoid weights (fractions of T).
   int sampleCount() const { return samples_.sampleCount(); }
+  /// Sample s's trapezoid weight, a fraction of T: (u_{s+1} − u_{s−1}) / 2.
+  double sampleWeight(int s) const { return sampleWeights_[static_cast<std::size_t>(s)]; }
   bool sampleCarriesBall(int s) const { return loaded_[static_cast<std::size_t>(s)]; }
 
   /// The motion's physics at the samples (and closure drift at the scenario's output samples).
@@ -246,7 +261,7 @@ class MotionProblem final : public NlpProblem {
     int contactRow(int contact, int c) const { return joints + rowsPerContact * (1 + contact) + c; }
     int infeasibility() const { return joints + rowsPerContact * (1 + contacts); }
     int power(int j) const { return infeasibility() + 1 + j; }
-    int closing = 0;  ///< joints that close a contact held over the whole motion
+    int closing = 0;  ///< joints that close an environment contact (closed_chains.hpp)
     int closingPosition(int k) const { return power(joints) + k; }
     int closingVelocity(int k) const { return power(joints) + closing + k; }
     int size() const { return power(joints) + 2 * closing; }
@@ -276,6 +291,10 @@ class MotionProblem final : public NlpProblem {
     /// and the closing joints' angles reached last (the next Newton start; NaN: none yet).
     Eigen::MatrixXd closureMap;
     Eigen::VectorXd closedAngles;
+    ClosureSet closed = 0;  ///< the contacts closed at this instant (closed_chains.hpp)
+    /// A window end's twin in contact: its Newton starts from the splines' angles, which the
+    /// window end's rows make the closure's (the branch the splines hand over).
+    bool startFromSplines = false;
   };
   using ThreadWorkspace = MotionWorkspace;
   /// A row of the registry: its kind, what `detail` says (joint, contact row, task
@@ -304,6 +323,14 @@ class MotionProblem final : public NlpProblem {
   /// The closing joints' state in w.q, w.v, w.a from the others' (Newton from b's last angles),
   /// with the map into `map` when given. False when the loop cannot close there.
   bool closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const;
+  /// Without angles to start from (a new problem, not started from another's: startClosureAt),
+  /// the closure at every sample in time order, Newton from the sample before's angles (from the
+  /// splines' where a window starts), and at each task instant from the nearest sample's: the
+  /// branch of the motion the splines start it on, followed through time — a Newton start from
+  /// splines that are unused inside a window (fixed at the start posture) may find another.
+  void startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoints, double duration);
+  /// Each task instant's Newton start: the nearest sample's angles.
+  void startTaskClosures();
   /// The same at an evaluation's own state: the map into b (with derivatives) and the angles
   /// reached kept in b for the next Newton start.
   void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives);
@@ -313,7 +340,7 @@ class MotionProblem final : public NlpProblem {
                    Eigen::MatrixXd& da) const;
   /// A gradient in the full state's first `stateBlocks` blocks (q; q, q̇; or q, q̇, q̈), brought
   /// to the spline joints' through the closure's map: g_F += Mᵀ g_C, g_C = 0.
-  void foldGradient(const Eigen::MatrixXd& map, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const;
+  void foldGradient(const Eigen::MatrixXd& map, ClosureSet closed, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
     Eigen::VectorXd probeX, weights, base, gradient;
@@ -384,6 +411,8 @@ class MotionProblem final : public NlpProblem {
   MotionParametrization parametrization_;
   SampledTrajectory samples_;
   std::vector<double> sampleTimes_;       ///< normalised, per NLP sample
+  std::vector<int> sampleSides_;          ///< −1, +1: the twin before, after an instant sampled twice; 0 otherwise
+  std::vector<std::vector<bool>> active_; ///< per environment contact and sample: in contact there
   std::vector<double> sampleWeights_;     ///< trapezoid weights, fractions of T
   std::vector<bool> loaded_;              ///< per sample: the ball still in the hand
   std::unique_ptr<DynamicsModel> loadedModel_;  ///< the robot with the ball (a throw)
@@ -395,7 +424,10 @@ class MotionProblem final : public NlpProblem {
   bool bilevel_ = false;
   std::vector<std::array<double, 2>> windows_;   ///< per environment contact, normalised
   std::unique_ptr<ContactForceParametrization> forces_;
-  std::unique_ptr<ClosedChains> closure_;  ///< null without a contact held over the whole motion
+  std::unique_ptr<ClosedChains> closure_;  ///< null without environment contacts
+  /// Per spline parameter: fixed and unused, every sample and task instant it reaches closing
+  /// its joint (a whole-motion contact's closing joints: all theirs; a window's: those inside it).
+  std::vector<bool> unusedParameter_;
   std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit
@@ -422,6 +454,7 @@ class MotionProblem final : public NlpProblem {
   Eigen::MatrixXd controlPoints_;
   Eigen::VectorXd cachedX_;
   bool cachedDerivatives_ = false, cacheValid_ = false;
+  bool closureStarted_ = false;  ///< every sample has closure angles to start Newton from
   bool sizedValues_ = false, sizedWithDerivatives_ = false;  ///< an evaluation of that kind has run (NoMallocScope)
 };
 

@@ -187,13 +187,16 @@ RigidTransform contactPoseAt(const Scenario& s, const ContactSurface& surface, c
 
 /// The closure of a contact as two tasks over its window (formulation.md §10): the contact
 /// frame's origin at its world position, the body's orientation at the one that puts the
-/// contact frame at its world orientation.
+/// contact frame at its world orientation. The motion problem holds them by construction
+/// (closed_chains.hpp); the configuration problem keeps them within the band. At each end of a
+/// window inside the motion, where the splines meet the closure, four tasks of equality: the
+/// frame at its pose and at rest (the motion C¹ there: its accelerations jump with the wrench).
 void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
   TaskSpec position;
   position.name = "closure of " + c.surface.name + " (position)";
   position.origin = c.origin;
   position.closure = true;
-  position.heldThroughout = !c.window;
+  position.heldByConstruction = true;
   position.kind = TaskKind::Position;
   position.body = s.robot.frames[static_cast<std::size_t>(c.surface.frame)].name;
   position.frame = c.surface.frame;
@@ -210,6 +213,29 @@ void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
   orientation.upper.setConstant(s.closureOrientationTolerance);
   s.tasks.push_back(position);
   s.tasks.push_back(orientation);
+  if (!c.window) return;
+  for (const double end : {c.start, c.end}) {
+    if (end <= 0.0 || end >= s.duration.initial) continue;
+    const std::string at = std::string(" at its window's ") + (end == c.start ? "start" : "end");
+    TaskSpec meet = position;
+    meet.heldByConstruction = false;
+    meet.start = meet.end = end, meet.window = false;
+    TaskSpec p = meet, o = orientation, v = meet, w = meet;
+    p.name = "closure of " + c.surface.name + at + " (position)";
+    p.lower = p.upper = c.worldPose.translation;
+    o.heldByConstruction = false;
+    o.start = o.end = end, o.window = false;
+    o.name = "closure of " + c.surface.name + at + " (orientation)";
+    o.lower.setZero(), o.upper.setZero();
+    v.name = "closure of " + c.surface.name + at + " (velocity)";
+    v.kind = TaskKind::LinearVelocity;
+    v.lower.setZero(), v.upper.setZero();
+    w.name = "closure of " + c.surface.name + at + " (angular velocity)";
+    w.kind = TaskKind::AngularVelocity;
+    w.point = Vector3::Zero();
+    w.lower.setZero(), w.upper.setZero();
+    for (const TaskSpec* t : {&p, &o, &v, &w}) s.tasks.push_back(*t);
+  }
 }
 
 void readContacts(const std::filesystem::path& file, const YAML::Node& list, const std::vector<ContactSurface>& surfaces,
@@ -375,12 +401,10 @@ std::string exactHessianRefusal(const Scenario& s) {
   if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
     return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
            "variables, or hessian: sample-differences";
-  for (const EnvironmentContact& c : s.contacts)
-    if (!c.window)
-      return "contact '" + c.surface.name + "' is held over the whole motion by construction, its loop's closing joints "
-             "following the others (docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no "
-             "rule for that map; use hessian: sample-differences or gauss-newton, or give the contact a window over the "
-             "whole motion to hold it by a band";
+  if (!s.contacts.empty())
+    return "contact '" + s.contacts.front().surface.name + "' is held by construction, its loop's closing joints following the others "
+           "(docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no rule for that map; use "
+           "hessian: sample-differences or gauss-newton";
   for (const Joint& joint : s.robot.joints)
     if (joint.type == JointType::Prismatic)
       return "prismatic joint '" + joint.name + "': its stencil assumes revolute joints";

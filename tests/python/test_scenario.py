@@ -113,30 +113,34 @@ def test_the_hessian_override_equals_the_cli(mcopt_exe, tmp_path):
 
 def test_the_chosen_formulation_is_the_one_the_files_checks_see(mcopt_exe, tmp_path):
     """As `mcopt run --contact-forces`: `hessian: exact` is refused for the bilevel formulation
-    with environment contacts, so the bundled throw with it opens for splines, and is refused
-    again when run as bilevel, with the CLI's message."""
+    with environment contacts for one reason, and for splines for another (the contacts, held by
+    construction, have no stencil): each with the CLI's message for the formulation chosen."""
     s = mcopt.Scenario(THROW, contact_forces="splines")
     assert s.contact_forces == "splines" and s["contact_forces"] == "bilevel"  # a choice, not a field
-    # The right sole held by a band (a window over the whole motion): held by construction, the
-    # exact option is refused whatever the formulation.
-    s["contacts"] = ["l_sole", {"surface": "r_sole", "window": [0.0, s["duration"]]}]
-    s["hessian"] = "exact"  # checked for splines: accepted
-    s.save(tmp_path / "exact.yaml")
+    with pytest.raises(mcopt.InputError, match="contact 'r_sole' is held by construction"):
+        s["hessian"] = "exact"  # checked for the formulation chosen, as it is set
+    # A file that asks for it (written around the checks: the saved throw, its line edited).
+    s.save(tmp_path / "throw.yaml")
+    text = (tmp_path / "throw.yaml").read_text()
+    assert text.count("hessian: sample-differences") == 1
+    (tmp_path / "exact.yaml").write_text(text.replace("hessian: sample-differences", "hessian: exact"))
     message = cli_error(mcopt_exe, "run", tmp_path / "exact.yaml", "--out", tmp_path / "o")
     assert "hessian: exact: the bilevel formulation" in message
     with pytest.raises(mcopt.InputError) as refused:
         mcopt.Scenario(tmp_path / "exact.yaml")
     assert str(refused.value) == message
-    opened = mcopt.Scenario(tmp_path / "exact.yaml", contact_forces="splines")
-    with pytest.raises(mcopt.InputError) as as_bilevel:
-        opened.run(contact_forces="bilevel")
-    assert str(as_bilevel.value) == message
+    splines = cli_error(mcopt_exe, "run", tmp_path / "exact.yaml", "--contact-forces", "splines", "--out", tmp_path / "o")
+    assert "contact 'r_sole' is held by construction" in splines
+    with pytest.raises(mcopt.InputError) as refused_splines:
+        mcopt.Scenario(tmp_path / "exact.yaml", contact_forces="splines")
+    assert str(refused_splines.value) == splines
     # Past the checks, it is the CLI's run with the same choice (iterate 0 alone).
-    run_cli(mcopt_exe, "run", tmp_path / "exact.yaml", "--contact-forces", "splines", "--max-iterations", 0,
+    opened = mcopt.Scenario(tmp_path / "throw.yaml", contact_forces="splines")
+    run_cli(mcopt_exe, "run", tmp_path / "throw.yaml", "--contact-forces", "splines", "--max-iterations", 0,
             "--out", tmp_path / "cli", check=False)
     cli = json.loads((tmp_path / "cli" / "result.json").read_text())
     result = opened.run(max_iterations=0)
-    assert result["solver"]["hessian"] == "exact" == cli["solver"]["hessian"]
+    assert result["contact_forces"] == "splines" == cli["contact_forces"]
     assert_same({k: v for k, v in result.items() if k != "x"}, cli, skip=UNTIMED)
     with pytest.raises(mcopt.InputError, match="unknown contact-force formulation 'springs'"):
         mcopt.Scenario(THROW, contact_forces="springs")
