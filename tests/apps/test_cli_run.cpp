@@ -985,6 +985,41 @@ TEST_CASE("run: the variables formulation started from the bilevel optimum start
   }
 }
 
+TEST_CASE("run: the lean reach rooted at its right sole, started from the left-rooted optimum, ends at the same optimum",
+          "[cli][run][multi-contact]") {
+  // Physics does not know which sole is the reference (closed_chains.hpp): the same motion has
+  // the same torques rooted at either (test_closed_chains.cpp), and the optimum of one rooting,
+  // handed to the other (`parameters`: the closing joints' motion fitted by splines, where the
+  // other rooting has them), is the other's optimum too — optimal there, at the same energy.
+  // (Independent runs may end in different local optima: docs/tutorials/multi-contact.md.)
+  if (kUnderSanitizers) return;  // two whole optimisations: the Release build runs them
+  const test::TempDir dir;
+  const auto leanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
+  const auto left = test::runMcopt("run " + test::quoted(leanReach) + " --out " + test::quoted(dir.path() / "left"));
+  INFO(left.all());
+  REQUIRE(left.exitCode == 0);
+  // The right sole the reference, where the left-rooted start posture puts it; the left sole held.
+  const auto rightRooted = scenarioVariant(leanReach, dir, [](YAML::Node& root) {
+    root["reference_body"] = "r_sole";
+    root["reference_pose"] = YAML::Load("{position: [0.0, -0.12, 0.0], rpy: [0.0, 0.0, 0.0]}");
+    root["contacts"][0] = "r_sole";
+    root["contacts"][1] = "l_sole";
+  }, "right_rooted.yaml");
+  const auto right = test::runMcopt("run " + test::quoted(rightRooted) + " --start-from " + test::quoted(dir.path() / "left") +
+                                    " --out " + test::quoted(dir.path() / "right"));
+  INFO(right.all());
+  CHECK(right.exitCode == 0);
+  const Json a = readJson(dir.path() / "left/result.json"), b = readJson(dir.path() / "right/result.json");
+  CHECK(b.at("status") == "optimal");
+  const double energyLeft = a.at("energy").get<double>(), energyRight = b.at("energy").get<double>();
+  INFO("energy rooted left " << energyLeft << " J, right " << energyRight << " J");
+  CHECK(std::abs(energyRight - energyLeft) <= 5e-3 * energyLeft);
+  // Every contact held exactly, the right-rooted run's left sole and hand among them.
+  for (const Json* r : {&a, &b})
+    for (const Json& c : r->at("contacts"))
+      if (!c.at("reference").get<bool>()) CHECK(c.at("closure_drift_m").get<double>() <= 1e-9);
+}
+
 TEST_CASE("run: --start-from refuses a motion that does not fit the scenario, naming the file and field", "[cli][run]") {
   const test::TempDir dir;
   // A real result of the kick (a few iterations), then copies of it with one field broken.
