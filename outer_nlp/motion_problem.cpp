@@ -1218,9 +1218,14 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   parametrization_.controlPoints(x.head(parameterCount_), controlPoints);
   Eigen::VectorXd q(jointCount_), v(jointCount_), a(jointCount_);
   atRelease.evaluate(0, controlPoints, T, q, v, a);
-  if (closure_) {
+  if (closure_) {  // Newton from the release sample's angles where it has some: the motion's branch
+    const SampleBlock& b = blocks_[static_cast<std::size_t>(releaseSample_)];
+    for (int k = 0; k < outputs_.closing; ++k) {
+      const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
+      if (closure_->closesIn(j, b.closed) && std::isfinite(b.closedAngles[k])) q[j] = b.closedAngles[k];
+    }
     ClosedChainData closing(model_, closure_->contactCount());
-    closure_->close(model_, closing, q, v, a, nullptr, closure_->closedAt(sampleTimes_[static_cast<std::size_t>(releaseSample_)], true));
+    closure_->close(model_, closing, q, v, a, nullptr, b.closed);
   }
   DynamicsData data(model_);
   inverseDynamics(model_, data, q, v, a);  // the bodies' poses and twists
