@@ -77,14 +77,25 @@ ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> 
   }
 }
 
-ClosureSet ClosedChains::closedAt(double u, bool ends) const {
+ClosureSet ClosedChains::closedAt(double u, int side) const {
   ClosureSet set = 0;
-  for (int i = 0; i < contactCount(); ++i) {
-    const std::array<double, 2>& w = contacts_[static_cast<std::size_t>(i)].window;
-    const bool inside = wholeMotion(i) || (ends ? u >= w[0] - 1e-9 && u <= w[1] + 1e-9 : u > w[0] + 1e-9 && u < w[1] - 1e-9);
-    if (inside) set |= ClosureSet{1} << i;
-  }
+  for (int i = 0; i < contactCount(); ++i)
+    if (wholeMotion(i) || insideWindow(u, contacts_[static_cast<std::size_t>(i)].window, side)) set |= ClosureSet{1} << i;
   return set;
+}
+
+void ClosedChains::placeAngles(const Eigen::VectorXd& angles, ClosureSet set, Eigen::Ref<Eigen::VectorXd> q) const {
+  for (int k = 0; k < closingCount(); ++k) {
+    const int j = closing_[static_cast<std::size_t>(k)];
+    if (closesIn(j, set) && std::isfinite(angles[k])) q[j] = angles[k];
+  }
+}
+
+void ClosedChains::readAngles(const Eigen::VectorXd& q, ClosureSet set, Eigen::Ref<Eigen::VectorXd> angles) const {
+  for (int k = 0; k < closingCount(); ++k) {
+    const int j = closing_[static_cast<std::size_t>(k)];
+    if (closesIn(j, set)) angles[k] = q[j];
+  }
 }
 
 bool ClosedChains::wholeMotion(int contact) const {

@@ -34,6 +34,7 @@
 #include "core/kinematics.hpp"
 #include "core/motion_derivatives.hpp"
 #include "core/spatial.hpp"
+#include "outer_nlp/contact_force_parametrization.hpp"
 
 namespace mcopt {
 
@@ -82,11 +83,18 @@ class ClosedChains {
   int contactOf(int joint) const { return contactOf_[static_cast<std::size_t>(joint)]; }
   /// Every contact.
   ClosureSet all() const { return contacts_.size() >= 32 ? ~ClosureSet{0} : (ClosureSet{1} << contacts_.size()) - 1; }
-  /// The contacts closed at u (a fraction of the motion): those held over the whole motion, and
-  /// those whose window holds u — its ends included with `ends`, not without (a window's end is
-  /// where the splines meet the closure: there the state is the splines').
-  ClosureSet closedAt(double u, bool ends) const;
+  /// The contacts closed at u (a fraction of the motion) on a side of it (insideWindow): those
+  /// held over the whole motion, and those whose window holds u there.
+  ClosureSet closedAt(double u, int side) const;
+  /// The contacts closed on both sides of u: at a window's end, not that window's (there the
+  /// state is the splines', which meet the closure).
+  ClosureSet closedAround(double u) const { return closedAt(u, -1) & closedAt(u, +1); }
   bool wholeMotion(int contact) const;
+  /// q's joints closing a contact of `set` from `angles` (one per closing joint, in their
+  /// order), where finite: a Newton start.
+  void placeAngles(const Eigen::VectorXd& angles, ClosureSet set, Eigen::Ref<Eigen::VectorXd> q) const;
+  /// `angles` of q's joints closing a contact of `set`; the others' left as they are.
+  void readAngles(const Eigen::VectorXd& q, ClosureSet set, Eigen::Ref<Eigen::VectorXd> angles) const;
   /// Whether a joint closes a contact of `set`.
   bool closesIn(int joint, ClosureSet set) const {
     const int c = contactOf_[static_cast<std::size_t>(joint)];

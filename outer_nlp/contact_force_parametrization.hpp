@@ -53,4 +53,12 @@ inline bool insideWindow(double u, const std::array<double, 2>& window) {
   return u >= window[0] - 1e-9 && u <= window[1] + 1e-9;
 }
 
+/// The same on one side of u, where an instant is sampled twice: −1 just before it (u in
+/// (u0, u1]), +1 just after it (u in [u0, u1)), 0 at u itself (the closed window).
+inline bool insideWindow(double u, const std::array<double, 2>& window, int side) {
+  if (side < 0) return u > window[0] + 1e-9 && u <= window[1] + 1e-9;
+  if (side > 0) return u >= window[0] - 1e-9 && u < window[1] - 1e-9;
+  return insideWindow(u, window);
+}
+
 }  // namespace mcopt

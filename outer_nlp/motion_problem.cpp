@@ -217,15 +217,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   for (const EnvironmentContact& c : scenario_.contacts) {
     windows_.push_back({c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)});
     // In contact at a sample inside the window; at a twin of a window's end, on the side within it.
-    const std::array<double, 2>& w = windows_.back();
     std::vector<bool> active(static_cast<std::size_t>(count));
-    for (int s = 0; s < count; ++s) {
-      const double u = sampleTimes_[static_cast<std::size_t>(s)];
-      const int side = sampleSides_[static_cast<std::size_t>(s)];
-      active[static_cast<std::size_t>(s)] = side < 0   ? u > w[0] + 1e-9 && u <= w[1] + 1e-9
-                                            : side > 0 ? u >= w[0] - 1e-9 && u < w[1] - 1e-9
-                                                       : insideWindow(u, w);
-    }
+    for (int s = 0; s < count; ++s)
+      active[static_cast<std::size_t>(s)] =
+          insideWindow(sampleTimes_[static_cast<std::size_t>(s)], windows_.back(), sampleSides_[static_cast<std::size_t>(s)]);
     active_.push_back(std::move(active));
     contactRows_.emplace_back(c.surface, RigidTransform{}, weight_, scenario_.inner.problem);
   }
@@ -294,7 +289,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     // At a window's end the task reads the splines' state: there they meet the closure.
-    if (closure_) b.closed = closure_->closedAt(taskSamples_.time(static_cast<int>(i), 1.0), false);
+    if (closure_) b.closed = closure_->closedAround(taskSamples_.time(static_cast<int>(i), 1.0));
     taskSamples_.chainRule(static_cast<int>(i), 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
   // Sparsity within a sample: with forces fixed by the formulation's variables, Γ_i (and
@@ -736,30 +731,20 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
 bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const {
   if (!closure_) return true;
   // Newton from the angles reached last at this instant: the same closure, in one or two steps.
-  for (int k = 0; k < outputs_.closing && !b.startFromSplines; ++k) {
-    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-    if (std::isfinite(b.closedAngles[k]) && closure_->closesIn(j, b.closed)) w.q[j] = b.closedAngles[k];
-  }
+  if (!b.startFromSplines) closure_->placeAngles(b.closedAngles, b.closed, w.q);
   return closure_->close(model_, w.closure, w.q, w.v, w.a, map, b.closed);
 }
 
 void MotionProblem::startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoints, double T) {
   ThreadWorkspace& w = workspaces_.front();
-  const std::vector<int>& closing = closure_->closingJoints();
   for (std::size_t s = 0; s < blocks_.size(); ++s) {
     SampleBlock& b = blocks_[s];
     samples_.evaluate(static_cast<int>(s), controlPoints, T, w.q, w.v, w.a);
-    for (int k = 0; k < outputs_.closing && s > 0; ++k) {
-      const int j = closing[static_cast<std::size_t>(k)];
-      if (closure_->closesIn(j, b.closed) && closure_->closesIn(j, blocks_[s - 1].closed) && !b.startFromSplines &&
-          std::isfinite(blocks_[s - 1].closedAngles[k]))
-        w.q[j] = blocks_[s - 1].closedAngles[k];
-    }
+    // From the sample before where it closed the same joints (a window's start: the splines').
+    if (s > 0 && !b.startFromSplines) closure_->placeAngles(blocks_[s - 1].closedAngles, b.closed & blocks_[s - 1].closed, w.q);
     closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr, b.closed);
-    for (int k = 0; k < outputs_.closing; ++k) {
-      const int j = closing[static_cast<std::size_t>(k)];
-      b.closedAngles[k] = closure_->closesIn(j, b.closed) ? w.q[j] : std::numeric_limits<double>::quiet_NaN();
-    }
+    b.closedAngles.setConstant(std::numeric_limits<double>::quiet_NaN());
+    closure_->readAngles(w.q, b.closed, b.closedAngles);
   }
   startTaskClosures();
   closureStarted_ = true;
@@ -782,10 +767,7 @@ void MotionProblem::startTaskClosures() {
 
 void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives) {
   if (!closure_ || !closeState(b, w, derivatives ? &b.closureMap : nullptr)) return;
-  for (int k = 0; k < outputs_.closing; ++k) {
-    const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-    if (closure_->closesIn(j, b.closed)) b.closedAngles[k] = w.q[j];
-  }
+  closure_->readAngles(w.q, b.closed, b.closedAngles);
 }
 
 void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
@@ -1220,10 +1202,7 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   atRelease.evaluate(0, controlPoints, T, q, v, a);
   if (closure_) {  // Newton from the release sample's angles where it has some: the motion's branch
     const SampleBlock& b = blocks_[static_cast<std::size_t>(releaseSample_)];
-    for (int k = 0; k < outputs_.closing; ++k) {
-      const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-      if (closure_->closesIn(j, b.closed) && std::isfinite(b.closedAngles[k])) q[j] = b.closedAngles[k];
-    }
+    closure_->placeAngles(b.closedAngles, b.closed, q);
     ClosedChainData closing(model_, closure_->contactCount());
     closure_->close(model_, closing, q, v, a, nullptr, b.closed);
   }
@@ -1321,16 +1300,11 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
     const double u = instants[static_cast<std::size_t>(s)].first;
     fine.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
     if (closure_) {  // Newton from the previous closed instant's angles (the first: the first sample's)
-      const ClosureSet closed = closure_->closedAt(u, !instants[static_cast<std::size_t>(s)].second);
-      for (int k = 0; k < outputs_.closing; ++k) {
-        const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-        if (closure_->closesIn(j, closed) && std::isfinite(previousAngles[k])) w.q[j] = previousAngles[k];
-      }
+      const bool end = instants[static_cast<std::size_t>(s)].second;
+      const ClosureSet closed = end ? closure_->closedAround(u) : closure_->closedAt(u, 0);
+      closure_->placeAngles(previousAngles, closed, w.q);
       closure_->close(model_, w.closure, w.q, w.v, w.a, nullptr, closed);
-      for (int k = 0; k < outputs_.closing; ++k) {
-        const int j = closure_->closingJoints()[static_cast<std::size_t>(k)];
-        if (closure_->closesIn(j, closed)) previousAngles[k] = w.q[j];
-      }
+      closure_->readAngles(w.q, closed, previousAngles);
     }
     inverseDynamics(model_, w.data, w.q, w.v, w.a);  // the poses and the twists
     for (int i = 0; i < contacts; ++i) {

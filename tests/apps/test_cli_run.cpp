@@ -944,6 +944,20 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
   CHECK_FALSE(std::filesystem::exists(dir.path() / "no"));
 }
 
+namespace {
+
+const std::filesystem::path kLeanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
+
+/// The bundled lean reach run to its optimum into dir/name (bilevel, active-set): its result.
+Json leanReachOptimum(const test::TempDir& dir, const std::string& name) {
+  const auto r = test::runMcopt("run " + test::quoted(kLeanReach) + " --out " + test::quoted(dir.path() / name));
+  INFO(r.all());
+  REQUIRE(r.exitCode == 0);
+  return readJson(dir.path() / name / "result.json");
+}
+
+}  // namespace
+
 TEST_CASE("run: the variables formulation started from the bilevel optimum starts feasible at its criterion and ends no higher",
           "[cli][run][multi-contact]") {
   // formulation.md §9: the bilevel optimum's wrenches are a feasible point of the single-level
@@ -951,13 +965,9 @@ TEST_CASE("run: the variables formulation started from the bilevel optimum start
   // do as well or better. docs/theory/outer-problem.md, "Multi-contact: the same physics".
   if (kUnderSanitizers) return;  // two whole optimisations: the Release build runs them
   const test::TempDir dir;
-  const auto leanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
-  const auto bilevel = test::runMcopt("run " + test::quoted(leanReach) + " --out " + test::quoted(dir.path() / "bilevel"));
-  INFO(bilevel.all());
-  REQUIRE(bilevel.exitCode == 0);
-  const Json first = readJson(dir.path() / "bilevel/result.json");
+  const Json first = leanReachOptimum(dir, "bilevel");
   REQUIRE(first.at("contact_forces") == "bilevel");
-  const auto single = test::runMcopt("run " + test::quoted(leanReach) + " --contact-forces variables --start-from " +
+  const auto single = test::runMcopt("run " + test::quoted(kLeanReach) + " --contact-forces variables --start-from " +
                                      test::quoted(dir.path() / "bilevel") + " --out " + test::quoted(dir.path() / "variables"));
   INFO(single.all());
   CHECK_THAT(single.output, Contains("starting from the motion of"));
@@ -994,12 +1004,9 @@ TEST_CASE("run: the lean reach rooted at its right sole, started from the left-r
   // (Independent runs may end in different local optima: docs/tutorials/multi-contact.md.)
   if (kUnderSanitizers) return;  // two whole optimisations: the Release build runs them
   const test::TempDir dir;
-  const auto leanReach = test::sourceDir() / "scenarios/hrp2_lean_reach.yaml";
-  const auto left = test::runMcopt("run " + test::quoted(leanReach) + " --out " + test::quoted(dir.path() / "left"));
-  INFO(left.all());
-  REQUIRE(left.exitCode == 0);
+  const Json a = leanReachOptimum(dir, "left");
   // The right sole the reference, where the left-rooted start posture puts it; the left sole held.
-  const auto rightRooted = scenarioVariant(leanReach, dir, [](YAML::Node& root) {
+  const auto rightRooted = scenarioVariant(kLeanReach, dir, [](YAML::Node& root) {
     root["reference_body"] = "r_sole";
     root["reference_pose"] = YAML::Load("{position: [0.0, -0.12, 0.0], rpy: [0.0, 0.0, 0.0]}");
     root["contacts"][0] = "r_sole";
@@ -1009,7 +1016,7 @@ TEST_CASE("run: the lean reach rooted at its right sole, started from the left-r
                                     " --out " + test::quoted(dir.path() / "right"));
   INFO(right.all());
   CHECK(right.exitCode == 0);
-  const Json a = readJson(dir.path() / "left/result.json"), b = readJson(dir.path() / "right/result.json");
+  const Json b = readJson(dir.path() / "right/result.json");
   CHECK(b.at("status") == "optimal");
   const double energyLeft = a.at("energy").get<double>(), energyRight = b.at("energy").get<double>();
   INFO("energy rooted left " << energyLeft << " J, right " << energyRight << " J");

@@ -138,10 +138,10 @@ TEST_CASE("closed chains: a contact left open keeps its joints, and the map of t
   REQUIRE(held.size() == 2);
   held[1].window = {0.3, 0.6};
   const ClosedChains chains(model, held, s.start);
-  CHECK(chains.closedAt(0.1, true) == 1U);
-  CHECK(chains.closedAt(0.3, true) == 3U);
-  CHECK(chains.closedAt(0.3, false) == 1U);
-  CHECK(chains.closedAt(0.45, false) == 3U);
+  CHECK(chains.closedAt(0.1, 0) == 1U);
+  CHECK(chains.closedAt(0.3, 0) == 3U);
+  CHECK(chains.closedAround(0.3) == 1U);
+  CHECK(chains.closedAround(0.45) == 3U);
   const int n = model.jointCount(), c = chains.closingCount();
   REQUIRE(c == 12);
   ClosedChainData d(model, 2);
