@@ -93,7 +93,9 @@ int runInner(const InnerOptions& o) {
 Runner addInner(CLI::App& app) {
   auto o = std::make_shared<InnerOptions>();
   app.add_option("--problems", o->problems, "inner problems (JSON, docs/theory/inner-problem.md)")->required();
-  app.add_option("--solver", o->solver, "active-set (default), slsqp or ipopt");
+  std::string solvers;
+  for (const InnerSolverEntry& e : innerSolvers()) solvers += "; " + e.name + ": " + e.description;
+  app.add_option("--solver", o->solver, "the inner solver, default active-set" + solvers);
   app.add_option("--contact-model", o->contactModel, "report (default), pyramid or wrench-cone");
   app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8)");
   app.add_option("--tikhonov", o->tikhonov, "ε added to the objective's Hessian diagonal (default 1e-9)");

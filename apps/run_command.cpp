@@ -246,7 +246,8 @@ Runner addRun(CLI::App& command) {
   command.add_option("--max-iterations", o->maxIterations,
                      "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,
-                     "active-set, slsqp or ipopt: override the scenario's inner.solver (bilevel, formulation.md §7)")
+                     innerSolverList() + ": override the scenario's inner.solver (bilevel, formulation.md §7; " +
+                         "`mcopt inner --help` says what each is)")
       ->check(CLI::IsMember(innerSolverNames()));
   command.add_option("--hessian", o->hessian,
                      "override the scenario's hessian and every continuation stage's; stages left differing in "

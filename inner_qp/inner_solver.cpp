@@ -23,8 +23,22 @@ const char* toString(InnerStatus status) {
   return "failed";
 }
 
+const std::vector<InnerSolverEntry>& innerSolvers() {
+  static const std::vector<InnerSolverEntry> registry = {
+      {"active-set", "ours: a dual active-set QP in an SQP loop over the cones, warm-started along the motion",
+       makeActiveSetSolver},
+      {"slsqp", "NLopt's SLSQP (sequential quadratic programming; the report's FSQP analogue)", makeSlsqpSolver},
+      {"ipopt", "Ipopt's interior point, one NLP a solve (the report's baseline)", makeIpoptSolver},
+  };
+  return registry;
+}
+
 const std::vector<std::string>& innerSolverNames() {
-  static const std::vector<std::string> names = {"active-set", "slsqp", "ipopt"};
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const InnerSolverEntry& e : innerSolvers()) out.push_back(e.name);
+    return out;
+  }();
   return names;
 }
 
@@ -33,11 +47,18 @@ bool isInnerSolverName(const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
+std::string innerSolverList() {
+  const auto& names = innerSolverNames();
+  std::string out;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+  return out;
+}
+
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings) {
-  if (name == "active-set") return makeActiveSetSolver(settings);
-  if (name == "slsqp") return makeSlsqpSolver(settings);
-  if (name == "ipopt") return makeIpoptSolver(settings);
-  throw InputError("solver: expected one of active-set, slsqp, ipopt; got '" + name + "'");
+  for (const InnerSolverEntry& e : innerSolvers())
+    if (e.name == name) return e.make(settings);
+  throw InputError("solver: expected " + innerSolverList() + "; got '" + name + "'");
 }
 
 namespace inner_detail {

@@ -73,11 +73,24 @@ std::unique_ptr<InnerSolver> makeIpoptSolver(const InnerSettings& settings = {})
 /// friction cones; allocation-free once it has seen a problem of the same size.
 std::unique_ptr<InnerSolver> makeActiveSetSolver(const InnerSettings& settings = {});
 
-/// The names makeInnerSolver knows, in the order documents list them.
+/// One registered inner solver: the name scenario files, `mcopt inner --solver` and the Python
+/// module know it by, one line saying what it is, and how to make it.
+struct InnerSolverEntry {
+  std::string name;
+  std::string description;
+  std::unique_ptr<InnerSolver> (*make)(const InnerSettings& settings);
+};
+
+/// Every inner solver, in the order documents list them (the registry, inner_solver.cpp: a new
+/// solver is its own file and one line there).
+const std::vector<InnerSolverEntry>& innerSolvers();
+/// Their names, in the same order.
 const std::vector<std::string>& innerSolverNames();
 bool isInnerSolverName(const std::string& name);
+/// The names for a message or a help text: "active-set, slsqp or ipopt".
+std::string innerSolverList();
 
-/// Solver by name: "active-set", "slsqp" or "ipopt"; throws InputError otherwise.
+/// Solver by name; throws InputError naming the registered ones otherwise.
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings = {});
 
 /// KKT residual of a result for its problem (balance shifted by the slack when Infeasible):

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// NLopt SLSQP on the inner problem (formulation.md §7). NLopt's headers stay in this file.
+// NLopt SLSQP on the inner problem (formulation.md §7). NLopt's header stays in this file.
 // NLopt returns no multipliers: they are estimated by least squares on the active set, and
 // a stop on an x/f tolerance is re-checked against the constraints by the common flow.
 #include <nlopt.h>
+
+#include <vector>
 
 #include "inner_qp/inner_nlp.hpp"
 
@@ -14,25 +16,53 @@ using inner_detail::BalanceMode;
 using inner_detail::InnerNlp;
 using inner_detail::RunOutcome;
 
-struct Counted {
-  const InnerNlp* nlp;
-  int evaluations = 0;
+/// An InnerNlp handed to an NLopt optimiser: objective, the balance equalities and the
+/// inequalities, with tolerances relative to the data's scale; counts the objective's evaluations.
+class NloptProblem {
+ public:
+  /// Sets `opt`'s objective and constraints from `nlp` (both must outlive the optimisation).
+  NloptProblem(nlopt_opt opt, const InnerNlp& nlp, const InnerSettings& settings) : nlp_(nlp) {
+    const double scale = inner_detail::dataScale(nlp.problem());
+    equalityTolerance_.assign(6, 1e-3 * settings.tolerance * scale);
+    inequalityTolerance_.assign(static_cast<std::size_t>(nlp.inequalityCount()), 1e-3 * settings.tolerance * scale);
+    nlopt_set_min_objective(opt, objective, this);
+    if (nlp.equalityCount() > 0) nlopt_add_equality_mconstraint(opt, 6, equalities, this, equalityTolerance_.data());
+    if (nlp.inequalityCount() > 0)
+      nlopt_add_inequality_mconstraint(opt, static_cast<unsigned>(nlp.inequalityCount()), inequalities, this,
+                                       inequalityTolerance_.data());
+  }
+  NloptProblem(const NloptProblem&) = delete;
+  NloptProblem& operator=(const NloptProblem&) = delete;
+
+  int evaluations() const { return evaluations_; }
+  /// Largest violation of the balance and the inequalities at x (absolute).
+  double violation(const Eigen::VectorXd& x) const {
+    Eigen::VectorXd g(nlp_.inequalityCount());
+    Vector6 e = Vector6::Zero();
+    if (nlp_.inequalityCount() > 0) nlp_.inequalities(x.data(), g.data(), nullptr);
+    nlp_.equalities(x.data(), e.data(), nullptr);
+    return std::max(e.cwiseAbs().maxCoeff(), g.size() > 0 ? g.maxCoeff() : 0.0);
+  }
+
+ private:
+  static double objective(unsigned, const double* x, double* gradient, void* data) {
+    auto* self = static_cast<NloptProblem*>(data);
+    ++self->evaluations_;
+    if (gradient) self->nlp_.objectiveGradient(x, gradient);
+    return self->nlp_.objective(x);
+  }
+  static void equalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
+    static_cast<NloptProblem*>(data)->nlp_.equalities(x, value, jacobian);
+  }
+  static void inequalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
+    static_cast<NloptProblem*>(data)->nlp_.inequalities(x, value, jacobian);
+  }
+
+  const InnerNlp& nlp_;
+  std::vector<double> equalityTolerance_, inequalityTolerance_;
+  int evaluations_ = 0;
 };
 
-double objective(unsigned, const double* x, double* gradient, void* data) {
-  auto* c = static_cast<Counted*>(data);
-  ++c->evaluations;
-  if (gradient) c->nlp->objectiveGradient(x, gradient);
-  return c->nlp->objective(x);
-}
-
-void equalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
-  static_cast<Counted*>(data)->nlp->equalities(x, value, jacobian);
-}
-
-void inequalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data) {
-  static_cast<Counted*>(data)->nlp->inequalities(x, value, jacobian);
-}
 
 RunOutcome runSlsqp(const ContactProblem& problem, BalanceMode balance, double band, const InnerSettings& settings,
                     Eigen::VectorXd& x) {
@@ -41,15 +71,8 @@ RunOutcome runSlsqp(const ContactProblem& problem, BalanceMode balance, double b
   const InnerNlp nlp(problem, balance, 1e-10 * inner_detail::dataScale(problem), band);
   const auto n = static_cast<unsigned>(nlp.variableCount());
   nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
-  Counted counted{&nlp};
+  const NloptProblem bound(opt, nlp, settings);
   const double scale = inner_detail::dataScale(nlp.problem());
-  std::vector<double> equalityTolerance(6, 1e-3 * settings.tolerance * scale);
-  std::vector<double> inequalityTolerance(static_cast<std::size_t>(nlp.inequalityCount()), 1e-3 * settings.tolerance * scale);
-  nlopt_set_min_objective(opt, objective, &counted);
-  if (nlp.equalityCount() > 0) nlopt_add_equality_mconstraint(opt, 6, equalities, &counted, equalityTolerance.data());
-  if (nlp.inequalityCount() > 0)
-    nlopt_add_inequality_mconstraint(opt, static_cast<unsigned>(nlp.inequalityCount()), inequalities, &counted,
-                                     inequalityTolerance.data());
   nlopt_set_xtol_rel(opt, 1e-14);
   nlopt_set_ftol_rel(opt, 1e-16);
   nlopt_set_maxeval(opt, settings.maxIterations);
@@ -60,15 +83,11 @@ RunOutcome runSlsqp(const ContactProblem& problem, BalanceMode balance, double b
   for (int attempt = 0; attempt < 4; ++attempt) {
     double value = 0.0;
     code = nlopt_optimize(opt, x.data(), &value);
-    Eigen::VectorXd g(nlp.inequalityCount());
-    Vector6 e = Vector6::Zero();
-    if (nlp.inequalityCount() > 0) nlp.inequalities(x.data(), g.data(), nullptr);
-    nlp.equalities(x.data(), e.data(), nullptr);
-    const double violation = std::max(e.cwiseAbs().maxCoeff(), g.size() > 0 ? g.maxCoeff() : 0.0);
+    const double violation = bound.violation(x);
     if (code == NLOPT_ROUNDOFF_LIMITED) continue;  // restart from where it stalled
     if (code < 0 || !x.allFinite() || violation <= settings.tolerance * scale) break;
   }
-  out.iterations = counted.evaluations;
+  out.iterations = bound.evaluations();
   // ROUNDOFF_LIMITED stops at a usable point more often than not: the common flow re-checks
   // feasibility, so it counts as a stop, not a failure.
   out.converged = (code > 0 || code == NLOPT_ROUNDOFF_LIMITED) && code != NLOPT_MAXEVAL_REACHED &&

@@ -315,7 +315,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
     const std::string name = yaml::text(file, node["solver"], "inner.solver");
     if (!isInnerSolverName(name))
       throw InputError(where(file, node["solver"], "inner.solver") + "unknown inner solver '" + name +
-                       "' (expected active-set, slsqp or ipopt)");
+                       "' (expected " + innerSolverList() + ")");
     s.inner.solverName = name;
   }
   if (node["contact_model"]) {

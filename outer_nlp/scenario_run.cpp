@@ -96,7 +96,7 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
   if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
   if (!o.innerSolver.empty()) {
     if (!isInnerSolverName(o.innerSolver))
-      throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected active-set, slsqp or ipopt)");
+      throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected " + innerSolverList() + ")");
     scenario.inner.solverName = o.innerSolver;
   }
   if (!o.hessian.empty()) overrideHessian(scenario, o.hessian);

@@ -88,6 +88,14 @@ py::dict resultDict(const InnerResultHandle& r) { return toPython(r.toJson()); }
 }  // namespace
 
 void bindInner(py::module_& m) {
+  m.def(
+      "inner_solvers",
+      [] {
+        py::dict out;
+        for (const InnerSolverEntry& e : innerSolvers()) out[py::str(e.name)] = e.description;
+        return out;
+      },
+      "The registered inner solvers, name → what it is, in the order the documents list them.");
   py::class_<InnerProblemHandle, std::shared_ptr<InnerProblemHandle>>(m, "InnerProblem", R"doc(
 One sample's inner problem (formulation.md §7): the contact wrenches F_i (in each contact's
 frame) that minimise Σ w Γ² + l Γ with Γ = tau0 − wrench_to_torque · F, subject to the balance
@@ -227,7 +235,7 @@ the factorisation `backend` (dense, klu or umfpack): {'dwrenches_dtau0', 'dwrenc
       });
 
   py::class_<InnerSolverHandle, std::shared_ptr<InnerSolverHandle>>(m, "InnerSolver", R"doc(
-An inner solver: 'active-set' (ours), 'slsqp' (NLopt) or 'ipopt'.)doc")
+An inner solver by its registered name (`mcopt.inner_solvers()`: name → what it is).)doc")
       .def(py::init([](const std::string& name, double tolerance, double kktTolerance, int maxIterations, bool warmStart,
                        bool polish) {
              InnerSettings settings;
@@ -242,7 +250,7 @@ An inner solver: 'active-set' (ours), 'slsqp' (NLopt) or 'ipopt'.)doc")
            py::arg("max_iterations") = 500, py::arg("warm_start") = true, py::arg("polish") = false,
            "Settings as in inner_solver.hpp; `warm_start` False is `mcopt inner --cold`, `polish` True is "
            "`mcopt inner --polish` (slsqp, ipopt: each answer polished on its own active set).")
-      .def_property_readonly("name", [](const InnerSolverHandle& s) { return s.name; }, "'active-set', 'slsqp' or 'ipopt'")
+      .def_property_readonly("name", [](const InnerSolverHandle& s) { return s.name; }, "its registered name")
       .def(
           "solve",
           [](InnerSolverHandle& s, const std::shared_ptr<InnerProblemHandle>& problem,

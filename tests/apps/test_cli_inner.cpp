@@ -55,8 +55,8 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
   test::TempDir dir;
   const auto file = dir.write("problems.json", input.dump());
 
-  for (const char* solver : {"active-set", "slsqp", "ipopt"}) {
-    const auto out = dir.path() / (std::string(solver) + ".json");
+  for (const std::string& solver : innerSolverNames()) {  // every registered solver
+    const auto out = dir.path() / (solver + ".json");
     const auto r = test::runMcopt("inner --problems " + test::quoted(file) + " --solver " + solver + " --out " +
                                   test::quoted(out));
     INFO(solver << ": " << r.errors);
@@ -139,7 +139,7 @@ TEST_CASE("inner: bad input names the file and field", "[cli][inner][input]") {
   bad = good;
   bad["problems"][0].erase("balance_wrench");
   expectError(bad, "", {"problems[0]", "missing 'balance_wrench'"});
-  expectError(good, " --solver qpoases", {"solver", "active-set, slsqp, ipopt"});
+  expectError(good, " --solver qpoases", {"solver", "expected " + innerSolverList(), "'qpoases'"});
   expectError(good, " --contact-model soft", {"--contact-model", "report, pyramid or wrench-cone"});
   const auto r = test::runMcopt("inner --problems " + test::quoted(dir.path() / "missing.json"));
   CHECK(r.exitCode == 2);

@@ -10,7 +10,7 @@ import pytest
 import mcopt
 from conftest import HRP2, assert_same, cli_error, run_cli, write_json
 
-SOLVERS = ["active-set", "slsqp", "ipopt"]
+SOLVERS = list(mcopt.inner_solvers())  # every registered solver
 MODELS = ["report", "pyramid", "wrench-cone"]
 
 
@@ -149,6 +149,14 @@ def test_bad_problems_raise_the_cli_messages(mcopt_exe, hrp2, tmp_path):
         assert str(raised.value).split(": ", 2)[2] == cli_words, k
 
 
+def test_the_registry_lists_the_solvers_in_document_order():
+    solvers = mcopt.inner_solvers()
+    assert list(solvers)[:3] == ["active-set", "slsqp", "ipopt"]
+    assert all(isinstance(d, str) and d for d in solvers.values())
+    for name in solvers:
+        assert mcopt.InnerSolver(name).name == name
+
+
 def test_bad_types_and_names_raise(hrp2):
     data = motion_problems(hrp2, "report", 2)[0].to_dict()
     with pytest.raises(ValueError, match="tau0"):
@@ -157,7 +165,7 @@ def test_bad_types_and_names_raise(hrp2):
         mcopt.InnerProblem(**{**data, "tau0": [float("nan")] * 30})
     with pytest.raises(mcopt.InputError, match="contact-model"):
         mcopt.InnerProblem(**data, contact_model="cone")
-    with pytest.raises(mcopt.InputError):
+    with pytest.raises(mcopt.InputError, match="expected active-set, slsqp or ipopt; got 'simplex'"):
         mcopt.InnerSolver("simplex")
     d = mcopt.Dynamics(hrp2, "r_sole")
     with pytest.raises(ValueError, match="unknown contact surface 'foot'"):
