@@ -11,6 +11,7 @@ namespace mcopt::cli {
 using Runner = std::function<int()>;
 
 Runner addRobotInfo(CLI::App& robot);
+Runner addRobotCheck(CLI::App& robot);
 Runner addDynamics(CLI::App& app);
 Runner addEvaluate(CLI::App& app);
 Runner addInner(CLI::App& app);

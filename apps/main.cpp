@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   std::vector<std::pair<CLI::App*, mcopt::cli::Runner>> runners;
   CLI::App* info = robot->add_subcommand("info", "bodies, actuated joints, mass and centre of mass");
   runners.emplace_back(info, mcopt::cli::addRobotInfo(*info));
+  CLI::App* check = robot->add_subcommand("check", "whether the robot can hold each named posture, on both feet and on each");
+  runners.emplace_back(check, mcopt::cli::addRobotCheck(*check));
   CLI::App* dynamics = app.add_subcommand("dynamics", "inverse dynamics of given states at a fixed reference body");
   runners.emplace_back(dynamics, mcopt::cli::addDynamics(*dynamics));
   CLI::App* evaluate = app.add_subcommand("evaluate", "torques, reference wrench and energy of a spline motion");
