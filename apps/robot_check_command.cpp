@@ -16,6 +16,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
+#include "core/actuators.hpp"
 #include "core/atomic_file.hpp"
 #include "core/dynamics_data.hpp"
 #include "core/errors.hpp"
@@ -191,6 +192,8 @@ int runRobotCheck(RobotCheckOptions o) {
   resolveFiles(o);
   const RobotModel robot = loadUrdfFile(o.robot);
   for (const std::string& w : robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
+  const ActuatorSet actuators = o.actuators.empty() ? defaultActuators(robot) : loadActuators(o.actuators, robot);
+  for (const std::string& n : urdfFrictionNotes(actuators, robot)) std::cerr << "mcopt: note: " << n << "\n";
   const std::vector<ContactSurface> surfaces = loadContactSurfaces(o.contacts, robot);
   const std::map<std::string, Eigen::VectorXd> postures = loadPostures(o.postures, robot);
   const std::vector<std::string> feet = findFeet(o, surfaces);

@@ -2,6 +2,7 @@
 // `mcopt robot info`: what a robot description contains, in text or JSON.
 #include <iomanip>
 #include <iostream>
+#include <map>
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
@@ -41,6 +42,25 @@ int runRobotInfo(const RobotInfoOptions& o) {
               // Limits: the actuator file over the URDF (formulation.md §2).
               << actuators.joints[j].velocityLimit << std::setw(11) << actuators.joints[j].torqueLimit << "\n";
   }
+  // Where the values in use came from, field by field: joints counted by source.
+  std::cout << "\n  where the actuator values come from (joints):\n";
+  for (const auto& [field, member] :
+       {std::pair{"velocity limit", &ActuatorSources::velocityLimit}, std::pair{"torque limit", &ActuatorSources::torqueLimit},
+        std::pair{"gear ratio", &ActuatorSources::gearRatio}, std::pair{"torque constant", &ActuatorSources::torqueConstant},
+        std::pair{"resistance", &ActuatorSources::resistance}, std::pair{"rotor inertia", &ActuatorSources::rotorInertia},
+        std::pair{"viscous friction", &ActuatorSources::viscousFriction},
+        std::pair{"dry friction", &ActuatorSources::dryFriction}}) {
+    std::map<std::string, int> counts;  // "actuator file joints.X" counted as "actuator file joints"
+    for (const ActuatorSources& from : actuators.sources) {
+      const std::string source = from.*member;
+      ++counts[source.rfind("actuator file joints.", 0) == 0 ? "actuator file joints" : source];
+    }
+    std::cout << "    " << std::left << std::setw(18) << field << std::right;
+    bool first = true;
+    for (const auto& [source, count] : counts) std::cout << (first ? "" : ", ") << source << " (" << count << ")", first = false;
+    std::cout << "\n";
+  }
+  for (const std::string& n : urdfFrictionNotes(actuators, robot)) std::cerr << "mcopt: note: " << n << "\n";
   return 0;
 }
 

@@ -19,6 +19,13 @@ const char* typeName(JointType type) {
   return "?";
 }
 
+json_io::Json sourcesJson(const ActuatorSources& from) {
+  return {{"velocity", from.velocityLimit},       {"effort", from.torqueLimit},
+          {"gear_ratio", from.gearRatio},         {"torque_constant", from.torqueConstant},
+          {"resistance", from.resistance},        {"rotor_inertia", from.rotorInertia},
+          {"viscous_friction", from.viscousFriction}, {"dry_friction", from.dryFriction}};
+}
+
 }  // namespace
 
 json_io::Json robotInfoJson(const RobotModel& robot, const ActuatorSet& actuators) {
@@ -49,7 +56,13 @@ json_io::Json robotInfoJson(const RobotModel& robot, const ActuatorSet& actuator
                              {"effort", finiteOrNull(effort(j))},
                              {"gear_ratio", a.gearRatio},
                              {"torque_constant", a.torqueConstant},
-                             {"resistance", a.resistance}});
+                             {"resistance", a.resistance},
+                             {"rotor_inertia", a.rotorInertia},
+                             {"viscous_friction", a.viscousFriction},
+                             {"dry_friction", a.dryFriction},
+                             {"sources", static_cast<std::size_t>(j) < actuators.sources.size()
+                                             ? sourcesJson(actuators.sources[static_cast<std::size_t>(j)])
+                                             : json_io::Json()}});
   }
   out["bodies"] = json_io::Json::array();
   for (const Body& body : robot.bodies)
@@ -57,6 +70,7 @@ json_io::Json robotInfoJson(const RobotModel& robot, const ActuatorSet& actuator
   out["frames"] = json_io::Json::array();
   for (const Frame& frame : robot.frames) out["frames"].push_back(frame.name);
   out["warnings"] = robot.warnings;
+  out["notes"] = urdfFrictionNotes(actuators, robot);
   return out;
 }
 

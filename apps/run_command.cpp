@@ -103,6 +103,7 @@ int runMotion(const RunOptions& o) {
   applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian});
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
+  for (const std::string& n : urdfFrictionNotes(scenario.actuators, scenario.robot)) std::cerr << "mcopt: note: " << n << "\n";
   MotionProblem problem(scenario);
   std::cout << "mcopt run " << o.scenario << "\n";
   if (!scenario.description.empty()) std::cout << "  " << scenario.description << "\n";

@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include "core/yaml_fields.hpp"
 
@@ -11,21 +12,54 @@ namespace mcopt {
 ActuatorSet defaultActuators(const RobotModel& robot) {
   ActuatorSet set;
   set.joints.resize(robot.joints.size());
+  set.sources.resize(robot.joints.size());
   for (std::size_t j = 0; j < robot.joints.size(); ++j) {
     const Joint& joint = robot.joints[j];
     ActuatorParameters& a = set.joints[j];
+    ActuatorSources& from = set.sources[j];
     a.torqueLimit = joint.limits.effort;
     a.velocityLimit = joint.limits.velocity;
     a.viscousFriction = joint.damping;
     a.dryFriction = joint.friction;
+    if (std::isfinite(joint.limits.effort)) from.torqueLimit = "URDF <limit effort>";
+    if (std::isfinite(joint.limits.velocity)) from.velocityLimit = "URDF <limit velocity>";
+    if (joint.damping != 0.0) from.viscousFriction = "URDF <dynamics damping>";
+    if (joint.friction != 0.0) from.dryFriction = "URDF <dynamics friction>";
   }
   return set;
+}
+
+std::vector<std::string> urdfFrictionNotes(const ActuatorSet& actuators, const RobotModel& robot) {
+  std::vector<std::string> notes;
+  for (const auto& [member, tag, meaning] :
+       {std::tuple{&ActuatorSources::viscousFriction, "URDF <dynamics damping>", "viscous friction"},
+        std::tuple{&ActuatorSources::dryFriction, "URDF <dynamics friction>", "dry friction"}}) {
+    std::vector<std::string> joints;
+    for (std::size_t j = 0; j < actuators.sources.size(); ++j)
+      if (actuators.sources[j].*member == tag) joints.push_back(robot.joints[j].name);
+    if (joints.empty()) continue;
+    std::string list;
+    for (std::size_t k = 0; k < joints.size() && k < 6; ++k) list += (k == 0 ? "" : ", ") + joints[k];
+    if (joints.size() > 6) list += " and " + std::to_string(joints.size() - 6) + " more";
+    notes.push_back(std::to_string(joints.size()) + " joint" + (joints.size() == 1 ? "" : "s") + " (" + list + ") take " +
+                    meaning + " from the " + tag + ": a joint-side value, used as motor-side " + meaning +
+                    " (the same only where the gear ratio is 1); set it in the actuator file to override");
+  }
+  return notes;
 }
 
 namespace {
 
 void readJoint(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
-               ActuatorParameters& a) {
+               ActuatorParameters& a, ActuatorSources& from) {
+  const std::string source = "actuator file " + field;
+  for (const auto& [key, member] :
+       {std::pair{"gear_ratio", &ActuatorSources::gearRatio}, std::pair{"torque_constant", &ActuatorSources::torqueConstant},
+        std::pair{"resistance", &ActuatorSources::resistance}, std::pair{"rotor_inertia", &ActuatorSources::rotorInertia},
+        std::pair{"viscous_friction", &ActuatorSources::viscousFriction},
+        std::pair{"dry_friction", &ActuatorSources::dryFriction}, std::pair{"torque_limit", &ActuatorSources::torqueLimit},
+        std::pair{"velocity_limit", &ActuatorSources::velocityLimit}})
+    if (node[key]) from.*member = source;
   yaml::rejectUnknownKeys(file, node, field,
                           {"gear_ratio", "torque_constant", "resistance", "rotor_inertia", "viscous_friction",
                            "dry_friction", "torque_limit", "velocity_limit"});
@@ -49,7 +83,7 @@ ActuatorSet readActuators(const std::filesystem::path& path, const RobotModel& r
   if (root["friction_sharpness"])
     set.frictionSharpness = yaml::positive(path, root["friction_sharpness"], "friction_sharpness");
   if (root["defaults"])
-    for (ActuatorParameters& a : set.joints) readJoint(path, root["defaults"], "defaults", a);
+    for (std::size_t j = 0; j < set.joints.size(); ++j) readJoint(path, root["defaults"], "defaults", set.joints[j], set.sources[j]);
   const YAML::Node joints = yaml::required(path, root, "joints", "");
   if (!joints.IsMap()) throw InputError(yaml::where(path, joints, "joints") + "expected a mapping joint name → values");
   for (const auto& entry : joints) {
@@ -58,7 +92,7 @@ ActuatorSet readActuators(const std::filesystem::path& path, const RobotModel& r
     if (index < 0)
       throw InputError(yaml::where(path, entry.first, "joints." + name) + "unknown joint (not an actuated joint of " +
                        robot.source + ")");
-    readJoint(path, entry.second, "joints." + name, set.joints[index]);
+    readJoint(path, entry.second, "joints." + name, set.joints[index], set.sources[index]);
   }
   return set;
 }

@@ -31,14 +31,29 @@ struct ActuatorParameters {
   double velocityLimit = std::numeric_limits<double>::infinity();  ///< |q̇| [rad/s]
 };
 
+/// Where each value of one joint's ActuatorParameters came from: "default" (the model's
+/// neutral value: N = K = 1, R = I_m = 0, no limit), "URDF <limit effort>", "URDF <limit
+/// velocity>", "URDF <dynamics damping>", "URDF <dynamics friction>" (joint side, read as motor
+/// side), "actuator file defaults" or "actuator file joints.NAME".
+struct ActuatorSources {
+  std::string gearRatio = "default", torqueConstant = "default", resistance = "default", rotorInertia = "default",
+              viscousFriction = "default", dryFriction = "default", torqueLimit = "default", velocityLimit = "default";
+};
+
 struct ActuatorSet {
   std::vector<ActuatorParameters> joints;  ///< URDF joint order
+  std::vector<ActuatorSources> sources;    ///< the same order: where each value came from
   double frictionSharpness = 100.0;        ///< ν in (3.8) [s/rad]; larger is closer to sign(Ω)
 };
 
 /// Defaults from the URDF alone: N = K = 1, R = 0, URDF <limit> effort/velocity,
 /// URDF <dynamics> damping/friction (joint side, equal to motor side when N = 1).
 ActuatorSet defaultActuators(const RobotModel& robot);
+
+/// One sentence per kind of friction taken from the URDF's <dynamics> (damping, friction) and
+/// not set by an actuator file: which joints, and that the URDF's joint-side values are read as
+/// motor-side friction (equal only with N = 1). Empty when no value comes from there.
+std::vector<std::string> urdfFrictionNotes(const ActuatorSet& actuators, const RobotModel& robot);
 
 /// Reads an actuator YAML file (docs/reference/robot-files.md); values not given keep the URDF
 /// defaults. Throws InputError naming file, line and field for unknown joints or keys,

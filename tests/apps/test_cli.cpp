@@ -32,6 +32,49 @@ TEST_CASE("robot info --json reports the HRP-2 joints, mass and centre of mass",
   CHECK(info["joints"][0]["velocity"].get<double>() != Approx(5.0));
 }
 
+TEST_CASE("robot info: each actuator value's source, and a note on friction read from the URDF", "[cli]") {
+  test::TempDir dir;
+  const auto urdf = dir.write("tiny.urdf", R"(<?xml version="1.0"?>
+<robot name="tiny">
+  <link name="base"><inertial><mass value="2.0"/><inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="hip" type="revolute">
+    <parent link="base"/><child link="thigh"/><axis xyz="0 1 0"/>
+    <limit lower="-1.5" upper="1.5" effort="50" velocity="3"/><dynamics damping="0.1" friction="0.2"/>
+  </joint>
+  <link name="thigh"><inertial><mass value="1.0"/><inertia ixx="0.004" iyy="0.004" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="knee" type="continuous"><parent link="thigh"/><child link="shin"/><axis xyz="0 1 0"/></joint>
+  <link name="shin"><inertial><mass value="0.5"/><inertia ixx="0.001" iyy="0.001" izz="0.001" ixy="0" ixz="0" iyz="0"/></inertial></link>
+</robot>)");
+  // The URDF alone: its limits and its <dynamics>, the latter said to be read as motor side.
+  auto r = test::runMcopt("robot info --robot " + test::quoted(urdf) + " --json");
+  REQUIRE(r.exitCode == 0);
+  Json info = Json::parse(r.output);
+  const Json& hip = info["joints"][0];
+  CHECK(hip["viscous_friction"] == 0.1);
+  CHECK(hip["dry_friction"] == 0.2);
+  CHECK(hip["sources"]["viscous_friction"] == "URDF <dynamics damping>");
+  CHECK(hip["sources"]["dry_friction"] == "URDF <dynamics friction>");
+  CHECK(hip["sources"]["effort"] == "URDF <limit effort>");
+  CHECK(hip["sources"]["gear_ratio"] == "default");
+  CHECK(info["joints"][1]["sources"]["effort"] == "default");  // a continuous joint without <limit>
+  REQUIRE(info["notes"].size() == 2);
+  CHECK_THAT(info["notes"][0].get<std::string>(), Contains("1 joint (hip) take viscous friction from the URDF <dynamics damping>") &&
+                                                   Contains("used as motor-side viscous friction"));
+  r = test::runMcopt("robot info --robot " + test::quoted(urdf));
+  CHECK_THAT(r.errors, Contains("mcopt: note: 1 joint (hip) take dry friction from the URDF <dynamics friction>"));
+  CHECK_THAT(r.output, Contains("viscous friction") && Contains("URDF <dynamics damping> (1)") && Contains("default (1)"));
+  // An actuator file that sets the viscous friction and the gear ratio: its values, and one note left.
+  const auto actuators = dir.write("actuators.yaml", "defaults: {gear_ratio: 100}\njoints:\n  hip: {viscous_friction: 0.0}\n");
+  r = test::runMcopt("robot info --robot " + test::quoted(urdf) + " --actuators " + test::quoted(actuators) + " --json");
+  REQUIRE(r.exitCode == 0);
+  info = Json::parse(r.output);
+  CHECK(info["joints"][0]["sources"]["viscous_friction"] == "actuator file joints.hip");
+  CHECK(info["joints"][0]["sources"]["gear_ratio"] == "actuator file defaults");
+  CHECK(info["joints"][0]["viscous_friction"] == 0.0);
+  REQUIRE(info["notes"].size() == 1);
+  CHECK_THAT(info["notes"][0].get<std::string>(), Contains("dry friction"));
+}
+
 TEST_CASE("robot info prints a readable table", "[cli]") {
   const auto r = test::runMcopt("robot info --robot " + test::quoted(kHrp2 / "hrp2.urdf"));
   REQUIRE(r.exitCode == 0);
