@@ -45,9 +45,6 @@ struct SupportCheck {
   bool checked = true;
   std::string note;        ///< why it was not checked, or what to know
   PostureCheck check;
-  std::string worstJoint;  ///< largest |Γ| / limit
-  double worstTorque = 0.0, worstLimit = 0.0;
-  double staticPower = 0.0;  ///< Σ P over the joints at rest [W]
 };
 
 /// The robot folder's files: DIR holds one .urdf and actuators.yaml, contacts.yaml, postures.yaml
@@ -134,17 +131,6 @@ SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, c
     const Scenario scenario = loadScenario(file);
     MotionProblem problem(scenario);
     result.check = checkFixedPostures(problem).front();
-    const SampledPhysics physics = problem.sampledPhysics(problem.initialPoint(scenario.start, scenario.end));
-    double worstRatio = -1.0;
-    for (int j = 0; j < physics.tau.rows(); ++j) {
-      const double limit = scenario.actuators.joints[static_cast<std::size_t>(j)].torqueLimit;
-      const double torque = std::abs(physics.tau(j, 0));
-      const double ratio = std::isfinite(limit) && limit > 0.0 ? torque / limit : 0.0;
-      if (ratio > worstRatio)
-        worstRatio = ratio, result.worstJoint = scenario.robot.joints[static_cast<std::size_t>(j)].name,
-        result.worstTorque = torque, result.worstLimit = limit;
-      result.staticPower += physics.power(j, 0);
-    }
   } catch (const InputError& e) {
     // The robot's files were read before; what fails here is the posture on this support (a
     // closure singular at it: a straight knee). Said without the scratch file's name.
@@ -178,12 +164,12 @@ Json checkJson(const SupportCheck& c) {
   j["holdable"] = c.check.holdable();
   j["support_margin_m"] = c.check.supportMargin;
   j["center_of_mass_m"] = {c.check.centerOfMass.x(), c.check.centerOfMass.y(), c.check.centerOfMass.z()};
-  j["largest_static_torque"] = {{"joint", c.worstJoint}, {"torque_N_m", c.worstTorque},
-                                {"limit_N_m", std::isfinite(c.worstLimit) ? Json(c.worstLimit) : Json(nullptr)}};
+  j["largest_static_torque"] = {{"joint", c.check.nearestLimit.joint}, {"torque_N_m", c.check.nearestLimit.torque},
+                                {"limit_N_m", std::isfinite(c.check.nearestLimit.limit) ? Json(c.check.nearestLimit.limit) : Json(nullptr)}};
   Json excess = Json::array();
   for (const auto& t : c.check.torques) excess.push_back({{"joint", t.joint}, {"torque_N_m", t.torque}, {"limit_N_m", t.limit}});
   j["torques_beyond_limits"] = excess;
-  j["static_electrical_power_W"] = c.staticPower;
+  j["static_electrical_power_W"] = c.check.staticPower;
   if (!c.check.innerStatus.empty()) j["inner_status"] = c.check.innerStatus;
   return j;
 }
@@ -258,11 +244,11 @@ int runRobotCheck(RobotCheckOptions o) {
       continue;
     }
     std::ostringstream torque;
-    torque << std::fixed << std::setprecision(1) << c.worstJoint << " " << c.worstTorque << " / "
-           << (std::isfinite(c.worstLimit) ? std::to_string(static_cast<int>(std::lround(c.worstLimit))) : "∞");
+    torque << std::fixed << std::setprecision(1) << c.check.nearestLimit.joint << " " << c.check.nearestLimit.torque << " / "
+           << (std::isfinite(c.check.nearestLimit.limit) ? std::to_string(static_cast<int>(std::lround(c.check.nearestLimit.limit))) : "∞");
     std::cout << std::fixed << std::setprecision(1) << std::showpos << std::setw(6) << 100.0 * c.check.supportMargin
               << " cm" << std::noshowpos << "   " << std::left << std::setw(32) << torque.str() << std::right
-              << std::setw(8) << c.staticPower << " W";
+              << std::setw(8) << c.check.staticPower << " W";
     if (!c.check.holdable()) std::cout << "   cannot hold it";
     if (c.check.innerStatus == "infeasible") std::cout << " (no admissible wrenches)";
     for (const auto& t : c.check.torques) std::cout << "; " << t.joint << " beyond its limit";

@@ -105,11 +105,15 @@ std::vector<PostureCheck> checkFixedPostures(MotionProblem& problem) {
     for (std::size_t i = 0; i < scenario.contacts.size(); ++i)
       if (problem.contactActive(static_cast<int>(i), sample)) addSurface(scenario.contacts[i].surface);
     check.supportMargin = signedDistanceToHull(corners, check.centerOfMass.head<2>());
+    double nearest = -1.0;
     for (int j = 0; j < model.jointCount(); ++j) {
       const double limit = scenario.actuators.joints[static_cast<std::size_t>(j)].torqueLimit;
-      const double torque = physics.tau(j, sample);
-      if (std::isfinite(limit) && std::abs(torque) > limit)
-        check.torques.push_back({scenario.robot.joints[static_cast<std::size_t>(j)].name, std::abs(torque), limit});
+      const double torque = std::abs(physics.tau(j, sample));
+      const std::string& name = scenario.robot.joints[static_cast<std::size_t>(j)].name;
+      if (std::isfinite(limit) && torque > limit) check.torques.push_back({name, torque, limit});
+      const double ratio = std::isfinite(limit) && limit > 0.0 ? torque / limit : 0.0;
+      if (ratio > nearest) nearest = ratio, check.nearestLimit = {name, torque, limit};
+      check.staticPower += physics.power(j, sample);
     }
     if (!physics.innerStatus.empty()) check.innerStatus = physics.innerStatus[static_cast<std::size_t>(sample)];
     checks.push_back(check);

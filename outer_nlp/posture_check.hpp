@@ -32,6 +32,8 @@ struct PostureCheck {
     double torque = 0.0, limit = 0.0;  ///< static |Γ| and its limit [N m]
   };
   std::vector<TorqueExcess> torques;  ///< joints whose static torque exceeds its limit
+  TorqueExcess nearestLimit;          ///< the joint with the largest static |Γ| / limit
+  double staticPower = 0.0;           ///< Σ P over the joints at rest [W]
   std::string innerStatus;            ///< bilevel: the inner problem at that sample ("infeasible": no admissible wrench holds it)
 
   bool holdable() const { return supportMargin >= 0.0 && torques.empty() && innerStatus != "infeasible"; }
