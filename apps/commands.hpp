@@ -20,5 +20,6 @@ Runner addStudy(CLI::App& app);
 Runner addPlot(CLI::App& app);
 Runner addReplay(CLI::App& app);
 Runner addReport(CLI::App& app);
+Runner addVerify(CLI::App& app);
 
 }  // namespace mcopt::cli

@@ -32,12 +32,16 @@ int main(int argc, char** argv) {
   runners.emplace_back(replayCommand, mcopt::cli::addReplay(*replayCommand));
   CLI::App* reportCommand = app.add_subcommand("report", "the report's figures and tables measured on this machine, beside its own");
   runners.emplace_back(reportCommand, mcopt::cli::addReport(*reportCommand));
+  CLI::App* verify = app.add_subcommand("verify", "certify a result's motion between its samples: every constraint on a fine grid");
+  runners.emplace_back(verify, mcopt::cli::addVerify(*verify));
   CLI::App* inner = app.add_subcommand("inner", "solve per-sample contact-force problems given as data");
   runners.emplace_back(inner, mcopt::cli::addInner(*inner));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // --help and --version exit 0; an option refused is bad input like any other: 2
+    // (docs/guides/troubleshooting.md), not CLI11's own codes.
+    return app.exit(e) == 0 ? 0 : 2;
   }
   try {
     for (auto& [command, runner] : runners)

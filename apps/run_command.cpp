@@ -20,6 +20,7 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
+#include "apps/result_motion.hpp"
 #include "apps/run_output.hpp"
 #include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/ipopt_driver.hpp"
@@ -47,23 +48,11 @@ struct RunOptions {
   bool strict = false;              ///< refuse a fixed posture the robot cannot hold (exit 2, nothing written)
 };
 
-/// A result's motion (result.json `parameters` by joint, `duration`) as the run's start.
+/// A result's motion (result.json `parameters` by joint, `duration`) as the run's start: any
+/// format (the force variables are fitted again to the inner problem's wrenches).
 void startFromResult(Scenario& scenario, const std::filesystem::path& from) {
-  const std::filesystem::path file = std::filesystem::is_directory(from) ? from / "result.json" : from;
-  const json_io::Json result = json_io::readFile(file);
-  if (!result.is_object()) throw InputError(file.string() + ": expected a result.json object");
-  for (const char* field : {"parameters", "duration"})
-    if (!result.contains(field)) throw InputError(file.string() + ": " + field + ": missing (not a result of mcopt run?)");
-  const json_io::Json& parameters = result["parameters"];
-  if (!parameters.is_object()) throw InputError(file.string() + ": parameters: expected an object of joint names");
-  std::map<std::string, std::vector<double>> byJoint;
-  for (const auto& [joint, values] : parameters.items()) {
-    const Eigen::VectorXd v = json_io::numbers(file, values, "parameters." + joint);
-    byJoint[joint] = std::vector<double>(v.data(), v.data() + v.size());
-  }
-  const json_io::Json& duration = result["duration"];
-  if (!duration.is_number()) throw InputError(file.string() + ": duration: expected a number");
-  startFromMotion(scenario, byJoint, duration.get<double>(), file.string());
+  const ResultMotion result = readResultMotion(from, false);
+  startFromMotion(scenario, result.parameters, result.duration, result.file.string());
 }
 
 

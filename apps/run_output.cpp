@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "apps/run_output.hpp"
 
+#include "apps/result_motion.hpp"
+
 #include <iomanip>
 #include <sstream>
 
@@ -78,12 +80,13 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
 
   RunFiles files;
   Json& result = files.result;
+  result["format"] = kResultFormat;
   result["status"] = toString(record.status);
   result["energy"] = r.energy;
   result["max_violation"] = violations.overall;
   result["message"] = record.message;
   if (!record.reason.empty()) result["reason"] = record.reason;
-  result["scenario"] = scenario.file.string();
+  result["scenario"] = std::filesystem::absolute(scenario.file).lexically_normal().string();
   result["objective_value"] = record.solver.objective;
   result["energy_form"] = scenario.energyForm == EnergyForm::Epigraph ? "epigraph" : "smooth_max";
   result["energy_fine"] = numberOrNull(r.fineEnergy);
@@ -103,6 +106,9 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
   const int m = problem.parametrization().parametersPerJoint();
   for (int j = 0; j < n; ++j) params[robot.joints[static_cast<std::size_t>(j)].name] = toJson(parameters.segment(j * m, m));
   result["parameters"] = params;
+  // The splines and variables formulations' contact-force variables z (formulation.md §9), in
+  // the problem's order: with the parameters, the whole motion (mcopt verify reads them).
+  result["contact_force_variables"] = toJson(Eigen::VectorXd(record.x.segment(problem.forceVariableStart(), problem.forceVariableCount())));
   // The limits the problem holds the motion to, beside the motion (plots, checks by others).
   Json lower = Json::array(), upper = Json::array(), velocity = Json::array(), torque = Json::array();
   for (int j = 0; j < n; ++j) {

@@ -469,13 +469,13 @@ void MotionProblem::buildStructure() {
   jacobianColumns_ = Eigen::Map<Eigen::VectorXi>(columns.data(), static_cast<Eigen::Index>(columns.size()));
 }
 
-std::string MotionProblem::rowName(int row) const {
+std::string MotionProblem::rowSubject(int row) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
   std::ostringstream name;
   switch (r.kind) {
     case ConstraintKind::VelocityLimit:
-      name << "velocity limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name << " (control points)";
-      return name.str();
+      name << "velocity limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
+      break;
     case ConstraintKind::TorqueLimit:
       name << "torque limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
       break;
@@ -502,13 +502,34 @@ std::string MotionProblem::rowName(int row) const {
     case ConstraintKind::Closure:
     case ConstraintKind::Task: {
       const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(r.block)])];
-      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << "xyz"[r.detail]
-           << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion";
-      return name.str();
+      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << "xyz"[r.detail];
+      break;
     }
   }
-  name << " at sample " << r.block;
   return name.str();
+}
+
+std::string MotionProblem::rowName(int row) const {
+  const Row& r = rows_[static_cast<std::size_t>(row)];
+  std::ostringstream name;
+  name << rowSubject(row);
+  switch (r.kind) {
+    case ConstraintKind::VelocityLimit: name << " (control points)"; break;
+    case ConstraintKind::Closure:
+    case ConstraintKind::Task: name << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion"; break;
+    default: name << " at sample " << r.block;
+  }
+  return name.str();
+}
+
+double MotionProblem::rowTime(int row, double T) const {
+  const Row& r = rows_[static_cast<std::size_t>(row)];
+  switch (r.kind) {
+    case ConstraintKind::VelocityLimit: return std::numeric_limits<double>::quiet_NaN();
+    case ConstraintKind::Closure:
+    case ConstraintKind::Task: return taskSamples_.time(r.block, T);
+    default: return T * sampleTimes_[static_cast<std::size_t>(r.block)];
+  }
 }
 
 void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
@@ -633,6 +654,19 @@ Eigen::VectorXd MotionProblem::initialPoint(const Eigen::VectorXd& start, const 
 }
 
 Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionParameters, double T) {
+  return motionPoint(motionParameters, T, nullptr);
+}
+
+Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionParameters, double T,
+                                               const Eigen::VectorXd& forceVariables) {
+  if (forceVariables.size() != forceVariableCount())
+    throw std::invalid_argument("pointFromMotion: " + std::to_string(forceVariables.size()) + " force variables for " +
+                                std::to_string(forceVariableCount()));
+  return motionPoint(motionParameters, T, &forceVariables);
+}
+
+Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParameters, double T,
+                                           const Eigen::VectorXd* forceVariables) {
   if (motionParameters.size() != parameterCount_)
     throw std::invalid_argument("pointFromMotion: " + std::to_string(motionParameters.size()) + " spline parameters for " +
                                 std::to_string(parameterCount_));
@@ -643,7 +677,9 @@ Eigen::VectorXd MotionProblem::pointFromMotion(const Eigen::VectorXd& motionPara
     for (int l = 0; l < m; ++l)
       if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) x[j * m + l] = scenario_.start[j];  // (variableBounds)
   if (durationIsFree()) x[parameterCount_] = T;
-  if (forces_) {
+  if (forces_ && forceVariables != nullptr) {
+    x.segment(forceStart_, forceVariableCount()) = *forceVariables;
+  } else if (forces_) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
     // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).
     std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, samples_.sampleCount()));

@@ -170,8 +170,14 @@ class MotionProblem final : public NlpProblem {
   const Eigen::VectorXi& jacobianRows() const override { return jacobianRows_; }
   const Eigen::VectorXi& jacobianColumns() const override { return jacobianColumns_; }
   ConstraintKind rowKind(int row) const { return rows_[static_cast<std::size_t>(row)].kind; }
-  /// e.g. "torque limit LLEG_JOINT3 at sample 12".
+  /// e.g. "torque limit of LLEG_JOINT3 at sample 12": rowSubject and where it is evaluated.
   std::string rowName(int row) const override;
+  /// What a row bounds, without its instant: "torque limit of LLEG_JOINT3", "r_hand friction
+  /// cone", "task 'toe' component x".
+  std::string rowSubject(int row) const;
+  /// The instant a row is evaluated at [s] for the duration T: its sample's or its task
+  /// instant's; NaN for the rows on control points (velocity limits), which bound the whole motion.
+  double rowTime(int row, double T) const;
 
   void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
   void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
@@ -194,6 +200,9 @@ class MotionProblem final : public NlpProblem {
   /// start of another formulation — the bilevel optimum's forces are then a feasible point of
   /// the single-level ones (formulation.md §9).
   Eigen::VectorXd pointFromMotion(const Eigen::VectorXd& motionParameters, double T);
+  /// The same with given force variables (a result's z: splines, variables; forceVariableCount()
+  /// of them, throws std::invalid_argument otherwise), the epigraph's slacks at max(P, 0).
+  Eigen::VectorXd pointFromMotion(const Eigen::VectorXd& motionParameters, double T, const Eigen::VectorXd& forceVariables);
   /// The same from `other`'s point x (another continuation stage's problem, whose energy form
   /// or formulation may lay out other variables after the shared spline parameters and T).
   Eigen::VectorXd pointFrom(const MotionProblem& other, const Eigen::VectorXd& x) {
@@ -311,6 +320,8 @@ class MotionProblem final : public NlpProblem {
     int block, output, local;
     double sign;
   };
+  /// pointFromMotion's point: the force variables given, or (null) fitted to the inner problem's wrenches.
+  Eigen::VectorXd motionPoint(const Eigen::VectorXd& motionParameters, double T, const Eigen::VectorXd* forceVariables);
   void evaluate(const Eigen::VectorXd& x, bool derivatives);
   void evaluateSample(int s, const Eigen::VectorXd& x, double duration, bool derivatives, ThreadWorkspace& w);
   void evaluateTaskInstant(int i, double duration, bool derivatives, ThreadWorkspace& w);

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "apps/run_output.hpp"
+#include "apps/verification_output.hpp"
 #include "core/atomic_file.hpp"
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
@@ -267,6 +268,33 @@ iteration and the result has status 'interrupted' with the last iterate. An exce
 raised by `progress` stops the run and is raised again. The overrides are those of
 `mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation, --hessian.)doc")
       .def("__repr__", [](const ScenarioHandle& s) { return "<mcopt.Scenario " + s.file.string() + ">"; });
+
+  m.def(
+      "verify",
+      [](const std::filesystem::path& result, int fine, const std::optional<std::filesystem::path>& scenario,
+         double energyTolerance, const std::optional<std::filesystem::path>& out) {
+        if (fine < 1) throw InputError("fine: " + std::to_string(fine) + ": expected an integer ≥ 1 (instants per sample interval)");
+        if (!(energyTolerance >= 0.0)) throw InputError("energy_tolerance: expected a relative tolerance ≥ 0");
+        cli::ResultVerification v;
+        {
+          py::gil_scoped_release release;
+          VerificationSettings settings;
+          settings.instantsPerInterval = fine;
+          settings.energyTolerance = energyTolerance;
+          v = cli::verifyResult(result, scenario.value_or(std::filesystem::path{}), settings);
+        }
+        const auto json = cli::verificationJson(v);
+        if (out) writeFileAtomically(*out, json.dump(1) + "\n");
+        return toPython(json);
+      },
+      py::arg("result"), py::arg("fine") = 10, py::arg("scenario") = py::none(),
+      py::arg("energy_tolerance") = VerificationSettings{}.energyTolerance, py::arg("out") = py::none(),
+      R"doc(Verifies a result's motion between its samples as `mcopt verify` does
+(docs/reference/verify.md) and returns verify.json's content as a dict: 'passed',
+'failed_checks', and 'checks', one dict per kind with 'worst', 'tolerance', 'where', 'time',
+'between_samples' and 'failing_times'. `result`: a result folder (or its result.json);
+`fine`: instants per sample interval; `scenario`: check against this file instead of the
+result's own; `out`: also write verify.json there. Bad input raises mcopt.InputError.)doc");
 }
 
 }  // namespace mcopt::python

@@ -3,7 +3,8 @@
 
 A shell block marked by the line `<!-- runnable -->` just before its fence is run as written;
 `<!-- runnable: cap -->` runs it with `--max-iterations 5` added to each `mcopt run`, which may
-then end with exit 4 (not optimal), because a full run is too long for CI. The blocks of one page
+then end with exit 4 (not optimal), because a full run is too long for CI; an `mcopt verify` of
+such a capped run may then end with exit 1 (its motion need not hold: it is no optimum). The blocks of one page
 run in order in one working folder that looks like a checkout after its build (build/release is
 this build tree; scenarios/, robots/, scripts/, examples/ the source's), so a later block reads
 what an earlier one wrote, as a reader following the page would."""
@@ -35,13 +36,17 @@ def runnable_blocks(text):
 
 
 def capped(code):
-    """The block with `--max-iterations` added to every `mcopt run` and exit 4 accepted."""
+    """The block with `--max-iterations` added to every `mcopt run` and exit 4 accepted, and exit 1
+    of every `mcopt verify` (of such a run)."""
     joined = re.sub(r"\s*\\\n\s*", " ", code)
     out = []
     for line in joined.splitlines():
         if re.search(r"apps/mcopt run\b", line):
             command, _, comment = line.partition("  #")
             line = f"{command.rstrip()} --max-iterations {CAP} || [ $? -eq 4 ]"
+        elif re.search(r"apps/mcopt verify\b", line):
+            command, _, comment = line.partition("  #")
+            line = f"{command.rstrip()} || [ $? -eq 1 ]"
         out.append(line)
     return "\n".join(out)
 
@@ -55,6 +60,7 @@ def test_the_pages_have_runnable_blocks():
 def test_capping_keeps_the_command_and_bounds_it():
     code = "build/release/apps/mcopt run scenarios/x.yaml \\\n  --out out/x   # a comment\nls out/x"
     assert capped(code) == f"build/release/apps/mcopt run scenarios/x.yaml --out out/x --max-iterations {CAP} || [ $? -eq 4 ]\nls out/x"
+    assert capped("build/release/apps/mcopt verify out/x   # exit 0") == "build/release/apps/mcopt verify out/x || [ $? -eq 1 ]"
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
