@@ -80,6 +80,9 @@ ResultMotion readResultMotion(const std::filesystem::path& folderOrFile, bool cu
     r.innerSolver = inner["solver"].get<std::string>();
   }
   r.forceVariables = json_io::numbers(r.file, result["contact_force_variables"], "contact_force_variables");
+  if (!result.contains("samples") || !result["samples"].is_number_integer() || result["samples"].get<int>() < 2)
+    throw InputError(file + ": samples: expected an integer ≥ 2 (the grid the motion was optimised on)");
+  r.samples = result["samples"].get<int>();
   return r;
 }
 
@@ -104,6 +107,16 @@ Scenario scenarioOfResult(const ResultMotion& result, const std::filesystem::pat
     throw InputError(result.file.string() + ": contacts: the result's contacts (" + list(result.contactNames) +
                      ") are not those of " + file.string() + " (" + list(contacts) + ")");
   startFromMotion(scenario, result.parameters, result.duration, result.file.string());
+  // The grid it was optimised on: a refined run's is finer than its file's (scenario_run.hpp refineRun).
+  if (result.samples != scenario.samples) {
+    const int intervals = scenario.samples - 1, refined = result.samples - 1;
+    if (refined % intervals != 0 || ((refined / intervals) & (refined / intervals - 1)) != 0)
+      throw InputError(result.file.string() + ": samples: " + std::to_string(result.samples) + " is not a refinement of " +
+                       file.string() + "'s " + std::to_string(scenario.samples) + " samples");
+    const Eigen::VectorXd parameters = scenario.initialMotion->parameters;
+    scenario = refinedScenario(scenario, parameters, result.duration);
+    while (scenario.samples < result.samples) scenario = refinedScenario(scenario, parameters, result.duration);
+  }
   return scenario;
 }
 

@@ -45,6 +45,7 @@ struct RunOptions {
   std::string hessian;                    ///< "", or a Hessian option: every stage's (ScenarioOverrides)
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
   std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
+  int refineRounds = -1;            ///< --refine [ROUNDS]; < 0: the scenario's
   bool strict = false;              ///< refuse a fixed posture the robot cannot hold (exit 2, nothing written)
 };
 
@@ -89,7 +90,7 @@ int runMotion(const RunOptions& o) {
   std::optional<ContactForces> contactForces;
   if (!o.contactForces.empty()) contactForces = parseContactForces(o.contactForces);
   Scenario scenario = loadScenario(o.scenario, contactForces);
-  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian});
+  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian, o.refineRounds});
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   for (const std::string& n : urdfFrictionNotes(scenario.actuators, scenario.robot)) std::cerr << "mcopt: note: " << n << "\n";
@@ -178,10 +179,40 @@ int runMotion(const RunOptions& o) {
   };
   events.keepRunning = [] { return stopRequested == 0; };
   RunRecord record = runScenario(scenario, problem, events);
+  // Refinement (docs/reference/verify.md, "Refine"): the optimum verified, solved again on a finer
+  // grid while it does not hold between its samples. Round 0's result is written first, so a run
+  // killed during a round leaves it; the rounds write no checkpoints.
+  std::optional<RefinedRun> refined;
+  MotionProblem* finalProblem = &problem;
+  if (scenario.refineRounds > 0 && record.status == OuterStatus::Optimal) {
+    writeRunOutput(o.out, problem, record);
+    std::cout << "refinement (up to " << scenario.refineRounds << " rounds): verifying the optimum between its samples\n";
+    ScenarioRunEvents roundEvents;
+    roundEvents.keepRunning = events.keepRunning;
+    roundEvents.onRefinementRound = [](const RefinementRound& r) {
+      std::cout << "  round " << r.round << ": " << r.samples << " samples, " << toString(r.status) << " after " << r.iterations
+                << " iterations; ";
+      if (r.verified) {
+        std::cout << "verified\n";
+        return;
+      }
+      if (r.status != OuterStatus::Optimal) {
+        std::cout << "not verified (not optimal)\n";
+        return;
+      }
+      std::cout << "broken:";
+      for (const VerificationCheck& c : r.failed)
+        std::cout << " " << c.kind << " " << std::setprecision(3) << c.worst << (c.where.empty() ? "" : " (" + c.where + ")");
+      std::cout << "\n";
+    };
+    refined = refineRun(scenario, problem, std::move(record), scenario.refineRounds, VerificationSettings{}, roundEvents);
+    record = std::move(refined->record);
+    if (refined->problem) finalProblem = refined->problem.get();
+  }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   if (record.status == OuterStatus::Interrupted) record.reason = "interrupted by a signal; the last iterate is written";
-  const RunFiles written = writeRunOutput(o.out, problem, record);
+  const RunFiles written = writeRunOutput(o.out, *finalProblem, record);
   const double energy = written.energy, violation = written.maxViolation;
 
   std::cout << "\nEXIT: " << record.message << "\n"
@@ -198,6 +229,11 @@ int runMotion(const RunOptions& o) {
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds
             << " s, motion " << record.optimisationSeconds << " s)\n"
             << "  results            " << o.out << "/result.json, trajectory.csv, power_fine.csv, states.json, contact_wrenches.json\n";
+  if (!record.refinement.empty()) {
+    const RefinementRound& last = record.refinement.back();
+    std::cout << "  refinement         " << record.refinement.size() - 1 << " round(s); " << last.samples << " samples: "
+              << (last.verified ? "verified between the samples" : "NOT verified between the samples") << "\n";
+  }
   if (const std::optional<ReleaseState>& ball = written.release) {
     // formulation.md §10: what a throw that did not converge got closest to is its written iterate.
     std::cout << "  release            " << std::setprecision(3) << ball->speed << " m/s at "
@@ -247,6 +283,12 @@ Runner addRun(CLI::App& command) {
                      "a result folder (or its result.json): start from its motion instead of the interpolated one; "
                      "configuration optimisation off; with another contact-force formulation its forces from the "
                      "inner problem along it");
+  command.add_option("--refine", o->refineRounds,
+                     "after the optimum, verify it between its samples and, while a check fails, solve again on twice "
+                     "the sample intervals from the motion reached, at most ROUNDS times (default 3 with the flag "
+                     "alone; 0: none; overrides the scenario's refine)")
+      ->expected(0, 1)
+      ->default_str("3");
   command.add_flag("--strict", o->strict,
                    "refuse a scenario whose fixed start or end posture the robot cannot hold at rest (centre of mass "
                    "outside the support polygon, a static torque beyond its limit): exit 2, nothing written");

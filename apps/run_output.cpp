@@ -274,6 +274,21 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
     totalIterations += stage.iterations;
   }
   result["continuation"] = stages;
+  // Refinement (docs/reference/verify.md, "Refine"): each round's grid, outcome and what verify
+  // found of its motion; the motion written is the last round's.
+  if (!record.refinement.empty()) {
+    Json rounds = Json::array();
+    for (const RefinementRound& round : record.refinement) {
+      Json failed = Json::array();
+      for (const VerificationCheck& c : round.failed)
+        failed.push_back({{"kind", c.kind}, {"worst", numberOrNull(c.worst)}, {"tolerance", c.tolerance}, {"where", c.where},
+                          {"time", numberOrNull(c.time)}, {"failing_times", c.failingTimes}});
+      rounds.push_back({{"round", round.round}, {"samples", round.samples}, {"status", toString(round.status)}, {"iterations", round.iterations},
+                        {"seconds", round.seconds}, {"verified", round.verified}, {"failed_checks", failed}});
+    }
+    result["refinement"] = rounds;
+  }
+  result["samples"] = scenario.samples;
   result["solver"]["iterations_all_stages"] = totalIterations;
   if (!record.stages.empty()) {
     result["solver"]["screening_rounds"] = record.stages.back().rounds;

@@ -431,7 +431,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance"});
+                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance", "refine"});
   Scenario s;
   s.file = file;
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
@@ -601,6 +601,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       s.configurationIterations =
           integerField(file, init["configuration_iterations"], "initialisation.configuration_iterations", 1);
   }
+  if (root["refine"]) s.refineRounds = integerField(file, root["refine"], "refine", 0);
   if (root["hessian"]) {
     const std::string hessian = yaml::text(file, root["hessian"], "hessian");
     try {

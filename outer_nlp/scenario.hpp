@@ -190,6 +190,11 @@ struct Scenario {
   };
   std::optional<InitialMotion> initialMotion;
 
+  /// Refinement rounds after the optimum (`refine`, `mcopt run --refine`; scenario_run.hpp
+  /// refineRun): while its motion does not verify between the samples, solve again on twice the
+  /// sample intervals. 0: none.
+  int refineRounds = 0;
+
   std::vector<SolverOption> solverOptions;
   HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/theory/outer-problem.md)
 

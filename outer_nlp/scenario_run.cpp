@@ -13,6 +13,7 @@
 #include "core/errors.hpp"
 #include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/configuration_problem.hpp"
+#include "outer_nlp/motion_verification.hpp"
 
 namespace mcopt {
 
@@ -94,6 +95,7 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
   else if (!o.configurationOptimisation.empty())
     throw InputError("configuration_optimisation: expected on or off, got '" + o.configurationOptimisation + "'");
   if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
+  if (o.refineRounds >= 0) scenario.refineRounds = o.refineRounds;
   if (!o.innerSolver.empty()) {
     if (!isInnerSolverName(o.innerSolver))
       throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected " + innerSolverList() + ")");
@@ -207,6 +209,15 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
       record.warnings.push_back("the posture reaching contact '" + reach.contact + "' over its window ended " +
                                 toString(reach.outcome.status) + " after " + std::to_string(reach.outcome.iterations) +
                                 " iterations: the initial motion may not close it there");
+  solveScenarioFrom(scenario, problem, x0, events, record);
+  record.totalSeconds = secondsSince(clock);
+  return record;
+}
+
+void solveScenarioFrom(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
+                       const ScenarioRunEvents& events, RunRecord& record) {
+  const auto clock = std::chrono::steady_clock::now();
+  const double before = record.totalSeconds;  // what the record already holds (a refinement's earlier rounds)
   IpoptSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
@@ -218,7 +229,7 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
                               r.stepSize, r.regularisation, r.barrier, r.timings, current.innerStatistics(), std::nullopt});
     if (r.iterate != nullptr && current.scenario().ball) record.history.back().missDistance = current.release(*r.iterate)->missDistance;
     record.optimisationSeconds = secondsSince(optimisationClock);
-    record.totalSeconds = secondsSince(clock);
+    record.totalSeconds = before + secondsSince(clock);
     bool go = !events.onIteration || events.onIteration(record, current, r);
     if (go && events.keepRunning) go = events.keepRunning();
     return go;
@@ -239,8 +250,72 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
     record.reason = "interrupted; the last iterate is written";
   else if (!record.solver.optimal() && record.reason.empty())
     record.reason = "Ipopt: " + record.solver.message;
-  record.totalSeconds = secondsSince(clock);
-  return record;
+  record.totalSeconds = before + secondsSince(clock);
+}
+
+Scenario refinedScenario(const Scenario& scenario, const Eigen::VectorXd& parameters, double duration) {
+  Scenario refined = scenario;
+  refined.samples = 2 * (scenario.samples - 1) + 1;  // every interval halved: every sample kept
+  refined.continuation.clear();                       // the motion reached is the start
+  refined.configurationOptimisation = false;
+  refined.initialMotion = Scenario::InitialMotion{parameters, duration};
+  if (refined.ball) {
+    // The release where the coarser grid had it (MotionProblem puts it on the nearest sample).
+    const int intervals = scenario.samples - 1;
+    const long release = std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals);
+    refined.ball->releaseTime = static_cast<double>(release) / intervals * scenario.duration.initial;
+    for (TaskSpec& task : refined.tasks)
+      if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease) task.start = task.end = refined.ball->releaseTime;
+  }
+  return refined;
+}
+
+RefinedRun refineRun(const Scenario& scenario, MotionProblem& problem, RunRecord record, int rounds,
+                     const VerificationSettings& settings, const ScenarioRunEvents& events) {
+  RefinedRun run;
+  std::vector<RefinementRound> done;
+  const Scenario* current = &scenario;
+  MotionProblem* currentProblem = &problem;
+  for (int round = 0;; ++round) {
+    RefinementRound r;
+    r.round = round;
+    r.samples = current->samples;
+    r.status = record.status;
+    r.iterations = 0;
+    for (const StageOutcome& stage : record.stages) r.iterations += stage.iterations;
+    r.seconds = record.totalSeconds;
+    if (record.status == OuterStatus::Optimal) {
+      const MotionVerification v = verifyMotion(*currentProblem, record.x, settings);
+      r.verified = v.passed();
+      for (const VerificationCheck& c : v.checks)
+        if (!c.passed()) r.failed.push_back(c);
+    }
+    done.push_back(r);
+    if (events.onRefinementRound) events.onRefinementRound(r);
+    // Done: verified, not optimal (nothing to refine from), out of rounds, or stopped.
+    if (r.verified || record.status != OuterStatus::Optimal || round == rounds) break;
+    auto next = std::make_unique<Scenario>(refinedScenario(*current, currentProblem->motionParameters(record.x),
+                                                           currentProblem->duration(record.x)));
+    auto nextProblem = std::make_unique<MotionProblem>(*next);
+    const Eigen::VectorXd x0 = nextProblem->pointWithWrenchesFrom(*currentProblem, record.x);
+    RunRecord refined;
+    // What the run found before the motion (postures, reaches, warnings) is the first round's.
+    refined.postureChecks = record.postureChecks;
+    refined.start = record.start, refined.end = record.end;
+    refined.contactPostures = record.contactPostures;
+    refined.warnings = record.warnings;
+    refined.configurationSeconds = record.configurationSeconds;
+    refined.totalSeconds = record.totalSeconds;
+    solveScenarioFrom(*next, *nextProblem, x0, events, refined);
+    record = std::move(refined);
+    run.scenario = std::move(next);
+    run.problem = std::move(nextProblem);
+    current = run.scenario.get();
+    currentProblem = run.problem.get();
+  }
+  run.record = std::move(record);
+  run.record.refinement = std::move(done);
+  return run;
 }
 
 }  // namespace mcopt

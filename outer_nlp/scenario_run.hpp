@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "outer_nlp/ipopt_driver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
+#include "outer_nlp/motion_verification.hpp"
 #include "outer_nlp/posture_check.hpp"
 #include "outer_nlp/scenario.hpp"
 
@@ -30,6 +32,7 @@ struct ScenarioOverrides {
   /// differing from the scenario in nothing but its iteration limit (a Hessian hand-over, as
   /// the bundled gauss-newton first stages are) is dropped.
   std::string hessian;
+  int refineRounds = -1;  ///< `--refine [ROUNDS]`; < 0: the scenario's
 };
 
 /// Applies the overrides; throws InputError for a value that is not one of the choices, and
@@ -68,6 +71,17 @@ struct IterationRecord {
   std::optional<double> missDistance;
 };
 
+/// One round of a refined run: the grid it ran on, how it ended, what verify found of its motion.
+struct RefinementRound {
+  int round = 0;    ///< 0: the scenario's own run
+  int samples = 0;  ///< the scenario's samples in that round
+  OuterStatus status = OuterStatus::InternalError;
+  int iterations = 0;    ///< Ipopt iterations of the round, every stage
+  double seconds = 0.0;  ///< the run's total time at the end of the round
+  bool verified = false;  ///< false too when the round did not end optimal (not verified)
+  std::vector<VerificationCheck> failed;  ///< the checks that failed on its motion
+};
+
 struct RunRecord {
   OuterStatus status = OuterStatus::InternalError;
   std::string message, reason;  ///< reason: why a run that is not optimal ended
@@ -92,6 +106,8 @@ struct RunRecord {
   /// What the run should not pass over in silence (result.json `warnings`): a fixed posture the
   /// robot cannot hold, a posture whose configuration optimisation did not end optimal, …
   std::vector<std::string> warnings;
+  /// With refinement (refineRun): every round, the run's own first; the record's motion is the last's.
+  std::vector<RefinementRound> refinement;
 };
 
 struct ScenarioRunEvents {
@@ -107,6 +123,17 @@ struct ScenarioRunEvents {
   /// Asked at every Ipopt iteration of every solve (postures included); false stops, and
   /// the run ends with status `interrupted` and its last iterate.
   std::function<bool()> keepRunning;
+  /// A refinement round has ended and been verified (refineRun).
+  std::function<void(const RefinementRound&)> onRefinementRound;
+};
+
+/// The outcome of refineRun: the last round's record, and its scenario and problem when that is
+/// not the run's own (null otherwise; MotionProblem keeps a reference to its scenario, so both
+/// live here).
+struct RefinedRun {
+  std::unique_ptr<Scenario> scenario;
+  std::unique_ptr<MotionProblem> problem;
+  RunRecord record;
 };
 
 /// The initial point of a run between the boundary postures `start` and `end`: through the
@@ -119,5 +146,24 @@ Eigen::VectorXd initialPointThroughContacts(MotionProblem& problem, const Eigen:
 /// Runs `scenario` on its own motion problem `problem` (built from it). Never throws for a
 /// numerical outcome (that is the record's status); throws InputError for what Ipopt refuses.
 RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const ScenarioRunEvents& events);
+
+/// runScenario's motion solve (its continuation stages and screening rounds) from x0, into
+/// `record` (its solver outcome, stages, history, status and x; totalSeconds added to).
+void solveScenarioFrom(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
+                       const ScenarioRunEvents& events, RunRecord& record);
+
+/// The scenario on twice its sample intervals (every sample kept; a throw's release where the
+/// coarser grid had it), started from the motion (parameters, T), without continuation stages
+/// or configuration optimisation: a refinement round's problem.
+Scenario refinedScenario(const Scenario& scenario, const Eigen::VectorXd& parameters, double duration);
+
+/// A run refined until its motion holds between its samples (`mcopt run --refine`, scenario
+/// `refine`; docs/reference/verify.md, "Refine"): the run's optimum is verified
+/// (motion_verification.hpp); while a check fails and rounds remain, the scenario is solved again
+/// on twice the sample intervals from the motion reached (refinedScenario; the force splines
+/// copied, the `variables` wrenches interpolated) and verified again. A round that does not end
+/// optimal ends the refinement. `record` is the run's own (round 0).
+RefinedRun refineRun(const Scenario& scenario, MotionProblem& problem, RunRecord record, int rounds,
+                     const VerificationSettings& settings, const ScenarioRunEvents& events);
 
 }  // namespace mcopt

@@ -134,7 +134,8 @@ py::dict iterationDict(const IterationRecord& h, const MotionProblem& problem) {
 
 py::dict run(const ScenarioHandle& s, const py::object& progress, const std::optional<std::filesystem::path>& out,
              const std::optional<int>& maxIterations, const std::optional<std::string>& contactForces,
-             const std::optional<bool>& configurationOptimisation, const std::optional<std::string>& hessian) {
+             const std::optional<bool>& configurationOptimisation, const std::optional<std::string>& hessian,
+             const std::optional<int>& refine) {
   // Another formulation than the one it was opened with is checked against the file as the
   // command line's is (loadScenario's contactForces): the file's checks see the run's formulation.
   const std::optional<ContactForces> forces = formulationArgument(contactForces);
@@ -144,6 +145,10 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
   if (contactForces) overrides.contactForces = *contactForces;
   if (hessian) overrides.hessian = *hessian;
   if (configurationOptimisation) overrides.configurationOptimisation = *configurationOptimisation ? "on" : "off";
+  if (refine) {
+    if (*refine < 0) throw InputError("refine: expected a number of rounds ≥ 0, got " + std::to_string(*refine));
+    overrides.refineRounds = *refine;
+  }
   applyOverrides(scenario, overrides);
   MotionProblem problem(scenario);
 
@@ -172,13 +177,18 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
     return interruption(e);
   };
   RunRecord record;
+  std::optional<RefinedRun> refined;  // its last round's scenario and problem, when refined
   {
     py::gil_scoped_release release;
     const std::lock_guard<std::mutex> oneIpoptAtATime(ipoptMutex());
     record = runScenario(scenario, problem, events);
+    if (scenario.refineRounds > 0 && record.status == OuterStatus::Optimal && !failure) {
+      refined = refineRun(scenario, problem, std::move(record), scenario.refineRounds, VerificationSettings{}, events);
+      record = std::move(refined->record);
+    }
   }
   if (failure) throw *failure;
-  const cli::RunFiles files = cli::makeRunFiles(problem, record);
+  const cli::RunFiles files = cli::makeRunFiles(refined && refined->problem ? *refined->problem : problem, record);
   if (out) cli::writeRunFiles(*out, files);
   py::dict result = toPython(files.result);
   result["x"] = vectorToNumpy(record.x);
@@ -255,7 +265,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
           "Writes the scenario (side-file paths made absolute, so it loads from anywhere), atomically.")
       .def("run", &run, py::arg("progress") = py::none(), py::arg("out") = py::none(),
            py::arg("max_iterations") = py::none(), py::arg("contact_forces") = py::none(),
-           py::arg("configuration_optimisation") = py::none(), py::arg("hessian") = py::none(),
+           py::arg("configuration_optimisation") = py::none(), py::arg("hessian") = py::none(), py::arg("refine") = py::none(),
            R"doc(Optimises the motion as `mcopt run` does and returns result.json's content as a dict
 (lists of numbers as numpy arrays: 'time' (N,), 'q', 'v', 'a', 'torques', 'power' (N, n), …)
 with 'x', the outer problem's variables. `out`: also write the run's files there.
@@ -266,7 +276,8 @@ is released while it runs (runs from several threads take turns: one Ipopt at a 
 linear solver MUMPS not being thread-safe); Ctrl-C (KeyboardInterrupt) stops it at the end of the current
 iteration and the result has status 'interrupted' with the last iterate. An exception
 raised by `progress` stops the run and is raised again. The overrides are those of
-`mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation, --hessian.)doc")
+`mcopt run`: --max-iterations, --contact-forces, --configuration-optimisation, --hessian,
+--refine (rounds; the result's 'refinement' says what each found, docs/reference/verify.md).)doc")
       .def("__repr__", [](const ScenarioHandle& s) { return "<mcopt.Scenario " + s.file.string() + ">"; });
 
   m.def(

@@ -13,6 +13,7 @@
 #include "outer_nlp/energy_balance.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_verification.hpp"
+#include "outer_nlp/scenario_run.hpp"
 
 namespace mcopt {
 
@@ -128,6 +129,36 @@ TEST_CASE("verify: a spline parameter nudged so that a torque limit breaks betwe
   CHECK(torque.worst > 0.004 * s.actuators.joints[static_cast<std::size_t>(plantedJoint)].torqueLimit);
   const std::vector<std::string> failures = v.failures();
   CHECK(std::find(failures.begin(), failures.end(), "torque_limit") != failures.end());
+}
+
+}  // namespace mcopt
+
+namespace mcopt {
+
+TEST_CASE("refine: a round's grid halves every interval, keeps every sample and a throw's release", "[outer][verify]") {
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_throw.yaml");
+  s.samples = 11;
+  MotionProblem coarse(s);
+  const Eigen::VectorXd x = coarse.initialPoint(s.start, s.end);
+  const Scenario refined = refinedScenario(s, coarse.motionParameters(x), coarse.duration(x));
+  CHECK(refined.samples == 21);
+  CHECK(refined.continuation.empty());
+  CHECK_FALSE(refined.configurationOptimisation);
+  REQUIRE(refined.initialMotion);
+  MotionProblem fine(refined);
+  const SampledPhysics a = coarse.sampledPhysics(x), b = fine.sampledPhysics(fine.pointWithWrenchesFrom(coarse, x));
+  // Every sample of the coarse grid is one of the fine grid's, with the same state there.
+  for (Eigen::Index k = 0; k < a.time.size(); ++k) {
+    Eigen::Index found = -1;
+    for (Eigen::Index l = 0; l < b.time.size() && found < 0; ++l)
+      if (std::abs(b.time[l] - a.time[k]) <= 1e-12) found = l;
+    INFO("sample " << k << " at " << a.time[k] << " s");
+    REQUIRE(found >= 0);
+    CHECK((b.q.col(found) - a.q.col(k)).cwiseAbs().maxCoeff() <= 1e-12);
+  }
+  REQUIRE(a.release);
+  REQUIRE(b.release);
+  CHECK(b.release->time == Approx(a.release->time).margin(1e-12));
 }
 
 }  // namespace mcopt

@@ -38,3 +38,15 @@ def test_verify_refuses_a_folder_without_a_result(tmp_path):
         mcopt.verify(tmp_path)
     with pytest.raises(mcopt.InputError, match="fine: 0"):
         mcopt.verify(tmp_path, fine=0)
+
+
+def test_run_with_refinement_reports_its_rounds():
+    import mcopt
+    kick = mcopt.Scenario(SOURCE / "scenarios" / "hrp2_kick.yaml")
+    with pytest.raises(mcopt.InputError, match="refine: expected a number of rounds"):
+        kick.run(refine=-1)
+    # One iteration: not optimal, so nothing to refine from — round 0 says so, no round follows.
+    result = kick.run(max_iterations=1, configuration_optimisation=False, refine=2)
+    assert result["status"] != "optimal"
+    assert "refinement" not in result  # refinement starts from an optimum only
+    assert result["samples"] == 100
