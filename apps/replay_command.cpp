@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 
@@ -53,11 +54,35 @@ std::string scriptText(std::string text, const std::filesystem::path& origin) {
   return text;
 }
 
+/// verify.json (docs/reference/verify.md) as the page's marks: its verdict and, per instant at
+/// which a check is broken, the checks broken there.
+nlohmann::json verifyMarks(const nlohmann::json& verify, const std::filesystem::path& file) {
+  if (!verify.is_object() || !verify.contains("passed") || !verify["passed"].is_boolean())
+    throw InputError(file.string() + ": passed: expected true or false (not a verify.json of mcopt verify?)");
+  if (!verify.contains("checks") || !verify["checks"].is_array()) throw InputError(file.string() + ": checks: expected a list");
+  std::map<double, std::vector<std::string>> broken;
+  for (std::size_t c = 0; c < verify["checks"].size(); ++c) {
+    const nlohmann::json& check = verify["checks"][c];
+    const std::string field = "checks[" + std::to_string(c) + "]";
+    if (!check.is_object() || !check.contains("kind") || !check["kind"].is_string())
+      throw InputError(file.string() + ": " + field + ".kind: expected a name");
+    if (!check.contains("failing_times")) throw InputError(file.string() + ": " + field + ".failing_times: missing");
+    const Eigen::VectorXd times = json_io::numbers(file, check["failing_times"], field + ".failing_times");
+    for (const double t : times) broken[t].push_back(check["kind"].get<std::string>());
+  }
+  nlohmann::json marks = nlohmann::json::array();
+  for (const auto& [time, kinds] : broken) marks.push_back({{"time", time}, {"checks", kinds}});
+  return {{"passed", verify["passed"].get<bool>()}, {"marks", marks}};
+}
+
 int replay(const ReplayOptions& o) {
   const std::filesystem::path resultFile = std::filesystem::path(o.result) / "result.json";
   if (!std::filesystem::is_regular_file(resultFile))
     throw InputError(resultFile.string() + ": file not found (give the folder `mcopt run --out` wrote)");
-  const nlohmann::json scene = replayScene(json_io::readFile(resultFile), resultFile);
+  nlohmann::json scene = replayScene(json_io::readFile(resultFile), resultFile);
+  // `mcopt verify`'s findings beside the result: the instants it found broken, marked on the timeline.
+  const std::filesystem::path verifyFile = std::filesystem::path(o.result) / "verify.json";
+  if (std::filesystem::exists(verifyFile)) scene["verify"] = verifyMarks(json_io::readFile(verifyFile), verifyFile);
 
   const std::filesystem::path three = threeDirectory();
   const std::filesystem::path threeScript = three / "three.min.js";
@@ -83,6 +108,9 @@ int replay(const ReplayOptions& o) {
   writeFileAtomically(out, page);
   std::cout << "mcopt replay " << o.result << "\n" << out.string() << " (" << page.size() / 1024 << " KiB, " << scene["time"].size()
             << " samples; open it in a browser, #t=SECONDS opens it paused at that instant)\n";
+  if (scene.contains("verify"))
+    std::cout << "  " << verifyFile.string() << ": " << scene["verify"]["marks"].size()
+              << " instants where a check is broken, marked on the timeline (n / p: the next / previous)\n";
   return 0;
 }
 

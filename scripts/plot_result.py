@@ -3,7 +3,9 @@
 """Figures of one optimised motion (docs/guides/plots.md), from the result folder `mcopt run` wrote:
 joint positions and torques within their limits, contact wrenches and friction-cone margins,
 centres of pressure inside their rectangles, power per joint and cumulative energy,
-Ipopt's convergence, and a throw's ball flight to its target. Called by `mcopt plot`; needs matplotlib (Debian's python3-matplotlib).
+Ipopt's convergence, and a throw's ball flight to its target; with `mcopt verify`'s verify.json
+beside result.json, the instants it found broken as red lines on the figures they concern, and a
+figure of its own (docs/reference/verify.md). Called by `mcopt plot`; needs matplotlib (Debian's python3-matplotlib).
 
     plot_result.py RESULT_DIR OUT_DIR    writes OUT_DIR/<figure>.png and .svg, one path a line
 """
@@ -57,7 +59,64 @@ def save(fig, out, stem, written):
     plt.close(fig)
 
 
-def within_limits(result, out, written, values_key, lower, upper, stem, what):
+# Which of verify.json's checks each figure shows (docs/reference/verify.md).
+POSITION_CHECKS = {"joint_position_limit", "closing_joint_limit"}
+TORQUE_CHECKS = {"torque_limit"}
+CONTACT_CHECKS = {"contact_unilateral", "contact_friction", "contact_cop", "contact_yaw", "contact_wrench_admissible",
+                  "inner_feasibility", "inner_problem_solved", "closure", "closure_drift"}
+
+
+def read_verify(folder):
+    """verify.json beside the result as {kind: (passed, [failing times])}, or None without one."""
+    path = os.path.join(folder, "verify.json")
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path) as f:
+            verify = json.load(f)
+    except (OSError, ValueError) as e:
+        raise BadResult(f"{path}: cannot read it ({e})")
+    if not isinstance(verify, dict) or not isinstance(verify.get("checks"), list):
+        raise BadResult(f"{path}: checks: expected a list (not a verify.json of mcopt verify?)")
+    checks = {}
+    for i, check in enumerate(verify["checks"]):
+        times = check.get("failing_times") if isinstance(check, dict) else None
+        if not isinstance(times, list) or not all(isinstance(t, (int, float)) for t in times) or "kind" not in check:
+            raise BadResult(f"{path}: checks[{i}]: expected a kind and failing_times, a list of numbers")
+        checks[check["kind"]] = (bool(check.get("passed")), times)
+    return checks
+
+
+def mark(ax, verify, kinds):
+    """Red lines at the instants verify found any of `kinds` broken; True when there were some."""
+    times = sorted({t for kind, (_, failing) in (verify or {}).items() if kind in kinds for t in failing})
+    for t in times:
+        ax.axvline(t, color="tab:red", lw=0.8, alpha=0.5, zorder=0)
+    return bool(times)
+
+
+def verify_figure(result, verify, out, written):
+    """Each check of verify.json: the instants at which it is broken, over the motion."""
+    if verify is None:
+        return
+    kinds = list(verify)
+    fig, ax = plt.subplots(figsize=(10, 0.45 * len(kinds) + 1.5))
+    for row, kind in enumerate(kinds):
+        _, times = verify[kind]
+        ax.plot(times, [row] * len(times), "|", color="tab:red", markersize=12)
+    ax.set_yticks(range(len(kinds)))
+    ax.set_yticklabels([f"{kind} ({'pass' if verify[kind][0] else 'FAIL'})" for kind in kinds], fontsize=8)
+    ax.set_ylim(-0.5, len(kinds) - 0.5)
+    ax.invert_yaxis()
+    ax.set_xlim(0.0, field(result, "duration"))
+    ax.set_xlabel("time [s]")
+    failed = [k for k in kinds if not verify[k][0]]
+    ax.set_title("mcopt verify: every check holds between the samples" if not failed else
+                 f"mcopt verify: {len(failed)} checks broken (red: the instants)")
+    save(fig, out, "verify", written)
+
+
+def within_limits(result, out, written, values_key, lower, upper, stem, what, verify=None, kinds=()):
     """Per limb, each joint's value scaled into its limits: 0 at the lower, 1 at the upper."""
     time, names, values = field(result, "time"), field(result, "joint_names"), field(result, values_key)
     groups = joint_groups(names)
@@ -74,21 +133,26 @@ def within_limits(result, out, written, values_key, lower, upper, stem, what):
             ax.plot(time, [(row[j] - lo) / (hi - lo) for row in values], style, color=colour, lw=1.2, label=names[j])
         ax.axhline(0.0, color="k", lw=0.8, ls="--")
         ax.axhline(1.0, color="k", lw=0.8, ls="--")
+        mark(ax, verify, kinds)
         ax.set_title(limb)
         ax.set_xlabel("time [s]")
         ax.set_ylabel("0 = lower, 1 = upper limit")
         ax.legend(fontsize=6, ncol=2)
     for ax in axes.flat[len(groups):]:
         ax.axis("off")
-    fig.suptitle(what + (f" ({unlimited} joints without limits not drawn)" if unlimited else ""))
+    broken = any(not verify[k][0] and verify[k][1] for k in kinds if k in verify) if verify else False
+    fig.suptitle(what + (f" ({unlimited} joints without limits not drawn)" if unlimited else "") +
+                 (" · red lines: instants mcopt verify found broken" if broken else ""))
     save(fig, out, stem, written)
 
 
-def contact_figures(result, out, written):
+def contact_figures(result, out, written, verify=None):
     time, contacts = field(result, "time"), field(result, "contacts")
     fig, axes = plt.subplots(len(contacts), 3, figsize=(15, 3.4 * len(contacts)), squeeze=False)
     for row, contact in zip(axes, contacts):
         wrench = contact["wrench"]
+        for ax in row:
+            mark(ax, verify, CONTACT_CHECKS)
         for ax, (first, unit, labels) in zip(row[:2], ((0, "N", "fx fy fz"), (3, "N m", "mx my mz"))):
             for i, label in enumerate(labels.split()):
                 ax.plot(time, [w[first + i] if w is not None else math.nan for w in wrench], label=label)
@@ -218,21 +282,24 @@ def main(argv):
     except (OSError, ValueError) as e:
         print(f"{source}: cannot read a result ({e})", file=sys.stderr)
         return 2
-    os.makedirs(argv[2], exist_ok=True)
     written = []
     try:
+        verify = read_verify(argv[1])
+        os.makedirs(argv[2], exist_ok=True)
         limits = field(result, "joint_limits")
         within_limits(result, argv[2], written, "q", limits["position_lower"], limits["position_upper"], "joint_positions",
-                      "joint positions within their limits")
+                      "joint positions within their limits", verify, POSITION_CHECKS)
         torque = [None if t is None else -t for t in limits["torque"]]
         within_limits(result, argv[2], written, "torques", torque, limits["torque"], "joint_torques",
-                      "joint torques within their limits (0 = −limit, 1 = +limit)")
-        contact_figures(result, argv[2], written)
+                      "joint torques within their limits (0 = −limit, 1 = +limit)", verify, TORQUE_CHECKS)
+        contact_figures(result, argv[2], written, verify)
+        verify_figure(result, verify, argv[2], written)
         energy_line = power_figure(result, argv[2], written)
         convergence_figure(result, argv[2], written)
         throw_figure(result, argv[2], written)
     except BadResult as e:
-        print(f"{source}: {e}", file=sys.stderr)
+        message = str(e)
+        print(message if message.startswith(os.path.join(argv[1], "verify.json")) else f"{source}: {message}", file=sys.stderr)
         return 2
     print("\n".join(written))
     print(energy_line)

@@ -209,6 +209,35 @@
   window.addEventListener('hashchange', openAtFragment);
   openAtFragment();
 
+  // mcopt verify's findings (verify.json beside the result): a tick on the timeline at every
+  // instant where a check is broken; n / p pause at the next / previous one.
+  const marks = scene.verify ? scene.verify.marks : [];
+  const markList = document.getElementById('verify-marks');
+  marks.forEach(({ time }) => {
+    const option = document.createElement('option');
+    option.value = String(time);
+    markList.appendChild(option);
+  });
+  function markNear(t) {
+    let best = null;
+    marks.forEach(m => { if (best === null || Math.abs(m.time - t) < Math.abs(best.time - t)) best = m; });
+    return best && Math.abs(best.time - t) <= duration / 200 ? best : null;
+  }
+  function verifyText() {
+    if (!scene.verify) return '';
+    if (!marks.length) return scene.verify.passed ? 'verify: every check holds between the samples' : 'verify: not verified (no instant marked)';
+    const near = markNear(t);
+    return `verify: broken at ${marks.length} instants (timeline ticks; n / p: next / previous)` +
+      (near ? ` · here, t = ${near.time.toFixed(3)} s: ${near.checks.join(', ')}` : '');
+  }
+  window.addEventListener('keydown', event => {
+    if (!marks.length || (event.key !== 'n' && event.key !== 'p')) return;
+    const next = event.key === 'n' ? marks.find(m => m.time > t + 1e-9) : [...marks].reverse().find(m => m.time < t - 1e-9);
+    if (!next) return;
+    t = next.time;
+    setPlaying(false);
+  });
+
   document.getElementById('legend').textContent =
     `force arrows: 1 m per ${1 / FORCE_SCALE} N at the centre of pressure · grey dot: centre of mass`;
   document.getElementById('caption').textContent =
@@ -221,6 +250,7 @@
     const size = renderer.getSize(new THREE.Vector2());
     const state = {
       t, playing, frames, errors, load_ms: loadMs, width: size.x, height: size.y,
+      verify: scene.verify ? { passed: scene.verify.passed, marks: marks.map(m => m.time), shown: verifyText() } : null,
       camera: { position: camera.position.toArray(), target: controls.target.toArray(), up: camera.up.toArray(), fov_deg: camera.fov },
       bodies: {} };
     const position = new THREE.Vector3(), orientation = new THREE.Quaternion(), centre = new THREE.Vector3();
@@ -253,6 +283,7 @@
     }
     slider.value = String(t);
     clock.textContent = `t = ${t.toFixed(3)} / ${duration.toFixed(3)} s`;
+    document.getElementById('verify').textContent = verifyText();
     show(t);
     controls.update();
     renderer.render(world, camera);

@@ -49,6 +49,25 @@ TEST_CASE("plot: every figure of a result, PNG and SVG, and the cumulative energ
   const auto elsewhere = test::runMcopt("plot " + test::quoted(out) + " --out " + test::quoted(dir.path() / "figures"));
   CHECK(elsewhere.exitCode == 0);
   CHECK(std::filesystem::exists(dir.path() / "figures/convergence.png"));
+  CHECK_FALSE(std::filesystem::exists(out / "plots/verify.png"));  // no verify.json yet
+
+  // With mcopt verify's verify.json beside the result: its figure, and its instants marked
+  // (docs/reference/verify.md); a verify.json it cannot read is refused by name.
+  const auto verified = test::runMcopt("verify " + test::quoted(out));
+  INFO(verified.all());
+  REQUIRE((verified.exitCode == 0 || verified.exitCode == 1));
+  const auto marked = test::runMcopt("plot " + test::quoted(out));
+  INFO(marked.all());
+  REQUIRE(marked.exitCode == 0);
+  for (const char* extension : {".png", ".svg"}) {
+    const auto file = out / "plots" / (std::string("verify") + extension);
+    CHECK(std::filesystem::exists(file));
+    CHECK_THAT(marked.output, Contains(file.string()));
+  }
+  std::ofstream(out / "verify.json") << R"({"passed": false, "checks": [{"kind": "task", "failing_times": ["soon"]}]})";
+  const auto refused = test::runMcopt("plot " + test::quoted(out));
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains((out / "verify.json").string() + ": checks[0]: expected a kind and failing_times"));
 }
 
 TEST_CASE("plot: a folder without a result, or a result without its fields, is refused", "[cli][plot]") {

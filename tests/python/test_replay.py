@@ -237,3 +237,28 @@ def test_a_throw_shows_the_ball_in_the_hand_then_on_its_flight(mcopt_exe, tmp_pa
         if 0 < xy[0] < image.shape[1] and 0 < xy[1] < image.shape[0] - 56:
             assert drawn_at(image, xy), f"{tag}: nothing drawn at the ball"
     assert np.allclose(expected, release["landing_point"], atol=1e-6)
+
+
+def test_the_instants_verify_found_broken_are_marked(mcopt_exe, replayed, tmp_path):
+    """With verify.json beside the result (docs/reference/verify.md), its failing instants are ticks
+    on the timeline, named where the page stands; a bad verify.json is refused with its field."""
+    tmp, result, _ = replayed
+    folder = tmp_path / "kick"
+    shutil.copytree(tmp / "kick", folder)
+    verify = {"passed": False, "checks": [
+        {"kind": "torque_limit", "passed": False, "failing_times": [0.4, 0.8]},
+        {"kind": "contact_cop", "passed": False, "failing_times": [0.8]},
+        {"kind": "task", "passed": True, "failing_times": []}]}
+    (folder / "verify.json").write_text(json.dumps(verify))
+    _, out, _ = run_cli(mcopt_exe, "replay", folder, "--out", tmp_path / "marked.html")
+    assert "2 instants where a check is broken" in out
+    state, _, console = open_page(tmp_path / "marked.html", "#t=0.8", tmp_path, "marked")
+    assert console == [] and state["errors"] == []
+    assert state["verify"]["marks"] == [0.4, 0.8] and state["verify"]["passed"] is False
+    assert "here, t = 0.800 s: torque_limit, contact_cop" in state["verify"]["shown"]
+    html = (tmp_path / "marked.html").read_text()
+    assert '"verify":{"marks":[{"checks":["torque_limit"],"time":0.4}' in html
+    (folder / "verify.json").write_text(json.dumps({"passed": False, "checks": [{"kind": "task", "failing_times": ["soon"]}]}))
+    code, _, err = run_cli(mcopt_exe, "replay", folder, "--out", tmp_path / "refused.html", check=False)
+    assert code == 2 and "verify.json: checks[0].failing_times[0]: expected a number" in err
+    assert not (tmp_path / "refused.html").exists()
