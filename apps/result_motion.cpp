@@ -80,9 +80,12 @@ ResultMotion readResultMotion(const std::filesystem::path& folderOrFile, bool cu
     r.innerSolver = inner["solver"].get<std::string>();
   }
   r.forceVariables = json_io::numbers(r.file, result["contact_force_variables"], "contact_force_variables");
-  if (!result.contains("samples") || !result["samples"].is_number_integer() || result["samples"].get<int>() < 2)
-    throw InputError(file + ": samples: expected an integer ≥ 2 (the grid the motion was optimised on)");
-  r.samples = result["samples"].get<int>();
+  // Absent: the scenario's (a result written before refinement existed).
+  if (result.contains("samples")) {
+    if (!result["samples"].is_number_integer() || result["samples"].get<int>() < 2)
+      throw InputError(file + ": samples: expected an integer ≥ 2 (the grid the motion was optimised on)");
+    r.samples = result["samples"].get<int>();
+  }
   return r;
 }
 
@@ -108,7 +111,7 @@ Scenario scenarioOfResult(const ResultMotion& result, const std::filesystem::pat
                      ") are not those of " + file.string() + " (" + list(contacts) + ")");
   startFromMotion(scenario, result.parameters, result.duration, result.file.string());
   // The grid it was optimised on: a refined run's is finer than its file's (scenario_run.hpp refineRun).
-  if (result.samples != scenario.samples) {
+  if (result.samples != 0 && result.samples != scenario.samples) {
     const int intervals = scenario.samples - 1, refined = result.samples - 1;
     if (refined % intervals != 0 || ((refined / intervals) & (refined / intervals - 1)) != 0)
       throw InputError(result.file.string() + ": samples: " + std::to_string(result.samples) + " is not a refinement of " +

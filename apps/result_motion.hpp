@@ -27,7 +27,7 @@ struct ResultMotion {
   std::vector<std::string> jointNames, contactNames;  ///< contactNames: the reference contact first
   std::map<std::string, std::vector<double>> parameters;  ///< spline parameters by joint
   double duration = 0.0;
-  int samples = 0;                 ///< the grid it was optimised on (a refined run's, finer than its scenario's)
+  int samples = 0;                 ///< the grid it was optimised on (a refined run's, finer than its scenario's); 0: the scenario's
   Eigen::VectorXd forceVariables;  ///< the splines / variables formulations' z (empty otherwise)
 };
 
