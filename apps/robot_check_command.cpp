@@ -36,6 +36,7 @@ struct RobotCheckOptions {
   std::string folder, robot, actuators, contacts, postures, out;
   std::vector<std::string> feet;
   bool json = false;
+  bool allowNonPhysicalInertia = false;  ///< load a URDF whose inertias a real body cannot have (with warnings)
 };
 
 /// One posture on one support.
@@ -128,7 +129,7 @@ SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, c
   result.posture = posture;
   result.support = support;
   try {
-    const Scenario scenario = loadScenario(file);
+    const Scenario scenario = loadScenario(file, std::nullopt, o.allowNonPhysicalInertia);
     MotionProblem problem(scenario);
     result.check = checkFixedPostures(problem).front();
   } catch (const InputError& e) {
@@ -176,7 +177,7 @@ Json checkJson(const SupportCheck& c) {
 
 int runRobotCheck(RobotCheckOptions o) {
   resolveFiles(o);
-  const RobotModel robot = loadUrdfFile(o.robot);
+  const RobotModel robot = loadUrdfFile(o.robot, {o.allowNonPhysicalInertia});
   for (const std::string& w : robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   const ActuatorSet actuators = o.actuators.empty() ? defaultActuators(robot) : loadActuators(o.actuators, robot);
   for (const std::string& n : urdfFrictionNotes(actuators, robot)) std::cerr << "mcopt: note: " << n << "\n";
@@ -271,6 +272,9 @@ Runner addRobotCheck(CLI::App& command) {
   command.add_option("--feet", o->feet, "the two contact surfaces the robot stands on, the first the reference (default: the two named *sole* or *foot*, in the contact file's order)")
       ->delimiter(',');
   command.add_flag("--json", o->json, "print JSON instead of the table");
+  command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,
+                   "load a URDF whose inertias a real body cannot have (not positive definite, or breaking the "
+                   "triangle inequality), with a warning for each");
   command.add_option("--out", o->out, "also write the JSON to this file (atomically)");
   return [o] { return runRobotCheck(*o); };
 }

@@ -46,6 +46,7 @@ struct RunOptions {
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
   std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
   int refineRounds = -1;            ///< --refine [ROUNDS]; < 0: the scenario's
+  bool allowNonPhysicalInertia = false;  ///< or the scenario's allow_nonphysical_inertia
   bool strict = false;              ///< refuse a fixed posture the robot cannot hold (exit 2, nothing written)
 };
 
@@ -89,7 +90,7 @@ int runMotion(const RunOptions& o) {
   // The formulation first: the file's checks that depend on it see the one that will run.
   std::optional<ContactForces> contactForces;
   if (!o.contactForces.empty()) contactForces = parseContactForces(o.contactForces);
-  Scenario scenario = loadScenario(o.scenario, contactForces);
+  Scenario scenario = loadScenario(o.scenario, contactForces, o.allowNonPhysicalInertia);
   applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian, o.refineRounds});
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
@@ -289,6 +290,9 @@ Runner addRun(CLI::App& command) {
                      "alone; 0: none; overrides the scenario's refine)")
       ->expected(0, 1)
       ->default_str("3");
+  command.add_flag("--allow-nonphysical-inertia", o->allowNonPhysicalInertia,
+                   "load a URDF whose inertias a real body cannot have (not positive definite, or breaking the "
+                   "triangle inequality), with a warning for each, as the scenario's allow_nonphysical_inertia: true");
   command.add_flag("--strict", o->strict,
                    "refuse a scenario whose fixed start or end posture the robot cannot hold at rest (centre of mass "
                    "outside the support polygon, a static torque beyond its limit): exit 2, nothing written");

@@ -171,7 +171,8 @@ BodyInertia readInertia(const urdf::Link& link, const std::string& source, const
       if (excess <= kNegligibleInertiaExcess || options.allowNonPhysicalInertia)
         warnings.push_back(msg.str());
       else
-        throw InputError(msg.str() + "; fix the file or allow non-physical inertias explicitly");
+        throw InputError(msg.str() + "; fix the file or allow non-physical inertias explicitly (--allow-nonphysical-inertia, "
+                         "or a scenario's allow_nonphysical_inertia: true)");
     };
     if (moments(0) < -tolerance) report("inertia is not positive definite", -moments(0));
     const double excess = moments(2) - moments(0) - moments(1);

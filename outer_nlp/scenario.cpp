@@ -341,7 +341,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
   }
 }
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces);
+                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia);
 
 }  // namespace
 
@@ -413,29 +413,35 @@ std::string exactHessianRefusal(const Scenario& s) {
   return {};
 }
 
-Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces) {
-  return loadScenario(yaml::loadFile(file), file, contactForces);
+Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces,
+                      bool allowNonPhysicalInertia) {
+  return loadScenario(yaml::loadFile(file), file, contactForces, allowNonPhysicalInertia);
 }
 
 Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces) {
-  return yaml::reading(file, [&] { return readScenario(root, file, contactForces); });
+                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia) {
+  return yaml::reading(file, [&] { return readScenario(root, file, contactForces, allowNonPhysicalInertia); });
 }
 
 namespace {
 
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces) {
+                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
   yaml::rejectUnknownKeys(file, root, "",
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance", "refine"});
+                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance", "refine",
+                           "allow_nonphysical_inertia"});
   Scenario s;
   s.file = file;
   if (root["description"]) s.description = yaml::text(file, root["description"], "description");
-  s.robot = loadUrdfFile(sideFile(file, root, "robot"));
+  // Inertias a real body cannot have (robot_model.hpp UrdfOptions): refused unless the file or the
+  // command line allows them, then loaded with a warning each.
+  s.allowNonPhysicalInertia = allowNonPhysicalInertia ||
+      (root["allow_nonphysical_inertia"] && flag(file, root["allow_nonphysical_inertia"], "allow_nonphysical_inertia"));
+  s.robot = loadUrdfFile(sideFile(file, root, "robot"), {s.allowNonPhysicalInertia});
   s.actuators = loadActuators(sideFile(file, root, "actuators"), s.robot);
   s.contactSurfacesFile = sideFile(file, root, "contact_surfaces");
   const auto surfaces = loadContactSurfaces(s.contactSurfacesFile, s.robot);

@@ -139,6 +139,7 @@ struct Scenario {
   std::filesystem::path contactSurfacesFile;  ///< the side file the contacts were read from
   std::string description;
   RobotModel robot;
+  bool allowNonPhysicalInertia = false;  ///< the robot's URDF loaded with UrdfOptions::allowNonPhysicalInertia
   ActuatorSet actuators;
   std::string referenceBody;
   RigidTransform referencePose;
@@ -250,7 +251,10 @@ std::string exactHessianRefusal(const Scenario& scenario);
 /// or postures, and impossible numbers. `contactForces`, when set, replaces the file's
 /// `contact_forces` before the checks that depend on it (`mcopt run --contact-forces`: a file
 /// whose `hessian: exact` the bilevel formulation refuses is accepted with `splines`).
-Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces = std::nullopt);
+/// `allowNonPhysicalInertia` (`--allow-nonphysical-inertia`) loads a URDF whose inertias a real
+/// body cannot have, as the file's `allow_nonphysical_inertia: true` does, with a warning each.
+Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces = std::nullopt,
+                      bool allowNonPhysicalInertia = false);
 /// (A scenario already parsed as YAML: outer_nlp/scenario_yaml.hpp.)
 
 /// The fields that name side files, relative to the scenario's folder: a copy of the scenario

@@ -26,6 +26,6 @@ void checkThrowTask(const std::filesystem::path& file, const YAML::Node& node, c
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.
 Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces = std::nullopt);
+                      std::optional<ContactForces> contactForces = std::nullopt, bool allowNonPhysicalInertia = false);
 
 }  // namespace mcopt

@@ -24,9 +24,12 @@ status 2. `mcopt run` exits 0 only when Ipopt reports an optimal solution (4 whe
 otherwise, 130 when interrupted: [results](results.md)). The input and output files are in
 [input files](input-files.md), [results](results.md), [studies](studies.md) and [the inner
 problem](../theory/inner-problem.md). URDFs whose inertias are not physical (Romeo's published
-model) load with `--allow-nonphysical-inertia` in `mcopt robot info` and `mcopt dynamics` only:
-`mcopt run` and `mcopt evaluate` refuse them, since an optimum on a mass matrix that is not
-positive definite would mean nothing.
+model) are refused unless allowed: `--allow-nonphysical-inertia` in `mcopt robot info`,
+`mcopt robot check`, `mcopt dynamics` and `mcopt run`, or `allow_nonphysical_inertia: true` in a
+scenario (which studies and the Python module then run too); each such body is then a warning.
+The torques of such a model are those of its numbers — inverse dynamics needs no positive
+definite mass matrix — but no real robot has that body: fix the inertias when you can.
+`mcopt evaluate` refuses them.
 """
 
 SUBCOMMAND = re.compile(r"^  ([a-z][a-z0-9-]*)\s{2,}")

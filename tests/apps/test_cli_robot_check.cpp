@@ -4,6 +4,8 @@
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <string>
 #include <nlohmann/json.hpp>
 
 #include "common/run_command.hpp"
@@ -142,4 +144,47 @@ TEST_CASE("robot check: a posture with a foot lifted is not checked on both feet
   expectError(" --robot " + test::quoted(kHrp2 / "hrp2.urdf") + " --contacts " + test::quoted(hands) + " --postures " +
                   test::quoted(postures),
               {"cannot tell the two feet", "--feet"});
+}
+
+TEST_CASE("non-physical inertias: refused by run and robot check, loaded with their warning when allowed", "[cli][robot]") {
+  // HRP-2 with one link whose principal moments break the triangle inequality (0.01 + 0.01 < 0.5).
+  const test::TempDir dir;
+  std::ifstream in(kHrp2 / "hrp2.urdf");
+  std::string urdf((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string original = R"(<inertia ixx="0.0807" ixy="0" ixz="0" iyy="0.06" iyz="0" izz="0.0807"/>)";
+  const std::size_t at = urdf.find(original);
+  REQUIRE(at != std::string::npos);
+  urdf.replace(at, original.size(), R"(<inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.5"/>)");
+  const auto folder = dir.path() / "robot";
+  std::filesystem::create_directories(folder);
+  std::ofstream(folder / "hrp2.urdf") << urdf;
+  for (const char* side : {"actuators.yaml", "contacts.yaml", "postures.yaml"}) std::filesystem::copy_file(kHrp2 / side, folder / side);
+
+  const auto refused = test::runMcopt("robot check " + test::quoted(folder));
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains("triangle inequality") && Contains("--allow-nonphysical-inertia"));
+  const auto allowed = test::runMcopt("robot check " + test::quoted(folder) + " --allow-nonphysical-inertia --json");
+  INFO(allowed.all());
+  CHECK(allowed.exitCode == 0);
+  CHECK_THAT(allowed.errors, Contains("mcopt: warning: ") && Contains("triangle inequality"));
+
+  // A scenario on it: refused, allowed by the flag or by its own field, with the warning.
+  std::ifstream kickFile(test::sourceDir() / "scenarios/hrp2_kick.yaml");
+  std::string kick((std::istreambuf_iterator<char>(kickFile)), std::istreambuf_iterator<char>());
+  for (const char* side : {"hrp2.urdf", "actuators.yaml", "contacts.yaml", "postures.yaml"}) {
+    const std::string from = std::string("../robots/hrp2/") + side;
+    kick.replace(kick.find(from), from.size(), (folder / side).string());
+  }
+  const auto scenario = dir.write("kick.yaml", kick);
+  const auto field = dir.write("kick_allowed.yaml", kick + "allow_nonphysical_inertia: true\n");
+  const std::string limits = " --max-iterations 1 --configuration-optimisation off --out " + test::quoted(dir.path() / "out");
+  const auto run = test::runMcopt("run " + test::quoted(scenario) + limits);
+  CHECK(run.exitCode == 2);
+  CHECK_THAT(run.errors, Contains("triangle inequality") && Contains("allow_nonphysical_inertia: true"));
+  for (const std::string& how : {test::quoted(scenario) + " --allow-nonphysical-inertia", test::quoted(field)}) {
+    const auto ran = test::runMcopt("run " + how + limits);
+    INFO(ran.all());
+    CHECK((ran.exitCode == 0 || ran.exitCode == 4));
+    CHECK_THAT(ran.errors, Contains("mcopt: warning: ") && Contains("triangle inequality"));
+  }
 }
