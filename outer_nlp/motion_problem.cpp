@@ -1318,7 +1318,10 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   // Closure drift between the samples: the contact frames on a fine grid, the scenario's output
   // samples or 10 instants per sample interval, whichever is finer, and each window's ends, read
   // from the splines there (where they meet the closure): how far each frame strays from its
-  // world pose and how fast it slides.
+  // world pose and how fast it slides. Nothing to do without environment contacts.
+  for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
+    drift->assign(static_cast<std::size_t>(contacts), 0.0);
+  if (contacts == 0) return p;
   const int fineCount = std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1);
   std::vector<std::pair<double, bool>> instants;  // u, at a window's end
   for (int s = 0; s < fineCount; ++s) instants.emplace_back(static_cast<double>(s) / (fineCount - 1), false);
@@ -1329,8 +1332,6 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   std::vector<double> fineTimes;
   for (const auto& instant : instants) fineTimes.push_back(instant.first);
   const SampledTrajectory fine(parametrization_, fineTimes);
-  for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
-    drift->assign(static_cast<std::size_t>(contacts), 0.0);
   Eigen::VectorXd previousAngles = closure_ ? Eigen::VectorXd(blocks_.front().closedAngles) : Eigen::VectorXd();
   for (int s = 0; s < fine.sampleCount(); ++s) {
     const double u = instants[static_cast<std::size_t>(s)].first;
