@@ -13,6 +13,7 @@
 #include "core/errors.hpp"
 #include "inner_qp/inner_solver.hpp"
 #include "outer_nlp/configuration_problem.hpp"
+#include "outer_nlp/energy_balance.hpp"
 #include "outer_nlp/motion_verification.hpp"
 
 namespace mcopt {
@@ -254,19 +255,12 @@ void solveScenarioFrom(const Scenario& scenario, MotionProblem& problem, const E
 }
 
 Scenario refinedScenario(const Scenario& scenario, const Eigen::VectorXd& parameters, double duration) {
-  Scenario refined = scenario;
-  refined.samples = 2 * (scenario.samples - 1) + 1;  // every interval halved: every sample kept
-  refined.continuation.clear();                       // the motion reached is the start
+  // The fine grid of two instants an interval (every sample kept, a throw's release where the
+  // coarser grid had it, no continuation), with the scenario's own torque-limit screening.
+  Scenario refined = fineGridScenario(scenario, 2);
+  refined.torqueScreening = scenario.torqueScreening;
   refined.configurationOptimisation = false;
   refined.initialMotion = Scenario::InitialMotion{parameters, duration};
-  if (refined.ball) {
-    // The release where the coarser grid had it (MotionProblem puts it on the nearest sample).
-    const int intervals = scenario.samples - 1;
-    const long release = std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals);
-    refined.ball->releaseTime = static_cast<double>(release) / intervals * scenario.duration.initial;
-    for (TaskSpec& task : refined.tasks)
-      if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease) task.start = task.end = refined.ball->releaseTime;
-  }
   return refined;
 }
 
