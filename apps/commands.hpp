@@ -12,6 +12,7 @@ using Runner = std::function<int()>;
 
 Runner addRobotInfo(CLI::App& robot);
 Runner addRobotCheck(CLI::App& robot);
+Runner addRobotInit(CLI::App& robot);
 Runner addDynamics(CLI::App& app);
 Runner addEvaluate(CLI::App& app);
 Runner addInner(CLI::App& app);

@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   runners.emplace_back(info, mcopt::cli::addRobotInfo(*info));
   CLI::App* check = robot->add_subcommand("check", "whether the robot can hold each named posture, on both feet and on each");
   runners.emplace_back(check, mcopt::cli::addRobotCheck(*check));
+  CLI::App* init = robot->add_subcommand("init", "write a robot folder from a URDF: side files, a standing posture, starter scenarios");
+  runners.emplace_back(init, mcopt::cli::addRobotInit(*init));
   CLI::App* dynamics = app.add_subcommand("dynamics", "inverse dynamics of given states at a fixed reference body");
   runners.emplace_back(dynamics, mcopt::cli::addDynamics(*dynamics));
   CLI::App* evaluate = app.add_subcommand("evaluate", "torques, reference wrench and energy of a spline motion");

@@ -16,6 +16,9 @@
 
 #include "apps/commands.hpp"
 #include "apps/json_io.hpp"
+#include "apps/python_script.hpp"
+#include "apps/robot_info_json.hpp"
+#include "apps/robot_visuals.hpp"
 #include "core/actuators.hpp"
 #include "core/atomic_file.hpp"
 #include "core/dynamics_data.hpp"
@@ -33,7 +36,7 @@ namespace fs = std::filesystem;
 using json_io::Json;
 
 struct RobotCheckOptions {
-  std::string folder, robot, actuators, contacts, postures, out;
+  std::string folder, robot, actuators, contacts, postures, out, plot;
   std::vector<std::string> feet;
   bool json = false;
   bool allowNonPhysicalInertia = false;  ///< load a URDF whose inertias a real body cannot have (with warnings)
@@ -103,7 +106,7 @@ std::string yamlPath(const std::string& file) { return Json(fs::absolute(file).s
 /// The posture at rest on `support` (the first the reference body), as `mcopt run` checks a
 /// fixed posture: a scenario written for the purpose, never optimised.
 SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, const std::string& posture,
-                          const std::vector<std::string>& support) {
+                          const std::vector<std::string>& support, const RobotModel& robot, const ContactSurface& reference) {
   std::ostringstream yaml;
   yaml << "description: mcopt robot check, " << posture << "\n"
        << "robot: " << yamlPath(o.robot) << "\n";
@@ -111,8 +114,13 @@ SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, c
   yaml << "actuators: " << yamlPath(o.actuators.empty() ? (scratch / "actuators.yaml").string() : o.actuators) << "\n";
   yaml << "contact_surfaces: " << yamlPath(o.contacts) << "\n"
        << "postures: " << yamlPath(o.postures) << "\n"
-       << "reference_body: " << Json(support.front()).dump() << "\n"
-       << "reference_pose: {position: [0.0, 0.0, 0.0], rpy: [0.0, 0.0, 0.0]}\n"
+       << "reference_body: " << Json(robot.frames[static_cast<std::size_t>(reference.frame)].name).dump() << "\n";
+  // The surface's link placed so that the surface lies at the origin.
+  const RigidTransform link = reference.placement.inverse();
+  const Matrix3& R = link.rotation;
+  yaml << std::setprecision(17) << "reference_pose: {position: [" << link.translation.x() << ", " << link.translation.y()
+       << ", " << link.translation.z() << "], rpy: [" << std::atan2(R(2, 1), R(2, 2)) << ", "
+       << std::asin(std::clamp(-R(2, 0), -1.0, 1.0)) << ", " << std::atan2(R(1, 0), R(0, 0)) << "]}\n"
        << "contacts: " << Json(support).dump() << "\n";
   if (support.size() > 1) yaml << "contact_forces: bilevel\ninner: {solver: active-set, contact_model: wrench-cone}\n";
   yaml << "duration: 1.0\nsamples: 5\ncontrol_points: 7\n"
@@ -156,6 +164,71 @@ std::pair<double, double> footOffset(const RobotModel& robot, const Eigen::Vecto
   const RigidTransform relative = pa.inverse() * pb;
   const double tilt = std::acos(std::clamp(relative.rotation(2, 2), -1.0, 1.0));
   return {relative.translation.z(), tilt};
+}
+
+/// One letter for where a value came from: f the actuator file, u the URDF, d mcopt's default.
+char sourceLetter(const std::string& source) {
+  if (source.rfind("actuator file", 0) == 0) return 'f';
+  if (source.rfind("URDF", 0) == 0) return 'u';
+  return 'd';
+}
+
+/// The values in use for every joint, each with its source letter.
+void printJointValues(const RobotModel& robot, const ActuatorSet& actuators) {
+  std::cout << "values in use (f: the actuator file, u: the URDF, d: mcopt's default; friction on the motor side)\n\n"
+            << "  joint                      torque lim.   vel. lim.   gear     K [N m/A]   R [Ω]      rotor [kg m²]   viscous      dry [N m]\n";
+  auto cell = [](double value, const std::string& source, int width) {
+    std::ostringstream text;
+    if (std::isfinite(value)) text << std::setprecision(4) << value;
+    else text << "∞";
+    text << " " << sourceLetter(source);
+    std::ostringstream padded;
+    padded << std::left << std::setw(width) << text.str();
+    return padded.str();
+  };
+  for (int j = 0; j < robot.jointCount(); ++j) {
+    const ActuatorParameters& a = actuators.joints[static_cast<std::size_t>(j)];
+    const ActuatorSources& from = actuators.sources[static_cast<std::size_t>(j)];
+    std::cout << "  " << std::left << std::setw(27) << robot.joints[static_cast<std::size_t>(j)].name << std::right
+              << cell(a.torqueLimit, from.torqueLimit, 14) << cell(a.velocityLimit, from.velocityLimit, 12)
+              << cell(a.gearRatio, from.gearRatio, 9) << cell(a.torqueConstant, from.torqueConstant, 12)
+              << cell(a.resistance, from.resistance, 11) << cell(a.rotorInertia, from.rotorInertia, 16)
+              << cell(a.viscousFriction, from.viscousFriction, 13) << cell(a.dryFriction, from.dryFriction, 10) << "\n";
+  }
+  std::cout << "\n";
+}
+
+/// What scripts/plot_contacts.py draws: each contact surface's rectangle and, in the surface's
+/// frame, the corners of its body's geometry (collision primitives, or the inertia box).
+Json contactGeometryJson(const RobotModel& robot, const std::string& urdf, const std::vector<ContactSurface>& surfaces) {
+  const auto collisions = bodyCollisionShapes(urdf, robot);
+  Json out = {{"robot", robot.name}, {"surfaces", Json::array()}};
+  for (const ContactSurface& s : surfaces) {
+    const Frame& frame = robot.frames[static_cast<std::size_t>(s.frame)];
+    const std::size_t body = static_cast<std::size_t>(frame.body);
+    std::vector<VisualShape> shapes = collisions[body];
+    std::string source = "collision primitives";
+    // Body frame → surface frame.
+    const RigidTransform surfaceInBody = frame.placement * s.placement;
+    if (shapes.empty()) {
+      // As `robot init` estimates a sole: the inertia's box along the surface's axes.
+      shapes.push_back(alignedInertiaBox(robot.bodies[body].inertia, surfaceInBody.rotation, 0.01));
+      source = "inertia box along the surface (no primitive in the URDF)";
+    }
+    const RigidTransform toSurface = surfaceInBody.inverse();
+    Json boxes = Json::array();
+    for (const VisualShape& shape : shapes) {
+      Json corners = Json::array();
+      for (const Vector3& c : shapeCorners(shape)) {
+        const Vector3 p = toSurface.apply(c);
+        corners.push_back({p.x(), p.y(), p.z()});
+      }
+      boxes.push_back(corners);
+    }
+    out["surfaces"].push_back({{"name", s.name}, {"link", frame.name}, {"body", robot.bodies[body].name},
+                               {"rectangle", {s.xMin, s.xMax, s.yMin, s.yMax}}, {"geometry", source}, {"boxes", boxes}});
+  }
+  return out;
 }
 
 Json checkJson(const SupportCheck& c) {
@@ -211,28 +284,41 @@ int runRobotCheck(RobotCheckOptions o) {
       skipped.note = note.str();
       results.push_back(skipped);
     } else {
-      results.push_back(checkSupport(o, scratch, name, feet));
+      results.push_back(checkSupport(o, scratch, name, feet, robot, surface(feet[0])));
       if (std::abs(height) > 1e-3) {
         std::ostringstream note;
         note << feet[1] << " " << std::setprecision(3) << 100.0 * height << " cm above " << feet[0];
         results.back().note = note.str();
       }
     }
-    results.push_back(checkSupport(o, scratch, name, {feet[0]}));
-    results.push_back(checkSupport(o, scratch, name, {feet[1]}));
+    results.push_back(checkSupport(o, scratch, name, {feet[0]}, robot, surface(feet[0])));
+    results.push_back(checkSupport(o, scratch, name, {feet[1]}, robot, surface(feet[1])));
   }
 
   Json report = {{"robot", robot.name},
                  {"files", {{"robot", o.robot}, {"actuators", o.actuators.empty() ? Json(nullptr) : Json(o.actuators)},
                             {"contacts", o.contacts}, {"postures", o.postures}}},
                  {"feet", feet},
+                 {"joints", robotInfoJson(robot, actuators)["joints"]},
                  {"checks", Json::array()}};
   for (const SupportCheck& c : results) report["checks"].push_back(checkJson(c));
   if (!o.out.empty()) writeFileAtomically(o.out, report.dump(2) + "\n");
+  if (!o.plot.empty()) {
+    fs::create_directories(o.plot);
+    const fs::path data = scratch / "contacts.json";
+    std::ofstream(data) << contactGeometryJson(robot, o.robot, surfaces).dump() << "\n";
+    const auto [exit, written] = runPythonScript("plot_contacts.py", {data.string(), o.plot});
+    if (!exit.exited || exit.code != 0) {
+      std::cerr << "mcopt: error: robot check --plot: the figure was not drawn (" << pythonFailure("plot_contacts.py", exit) << ")\n";
+      return 1;
+    }
+    std::cerr << written;
+  }
   if (o.json) {
     std::cout << report.dump(2) << "\n";
     return 0;
   }
+  printJointValues(robot, actuators);
   std::cout << "robot " << robot.name << " (" << o.robot << "), feet " << feet[0] << " and " << feet[1]
             << "; each posture at rest (margin: the centre of mass inside (+) or outside (−) the support polygon)\n\n"
             << "  posture               support                  margin    largest static torque / limit       power   \n";
@@ -276,6 +362,9 @@ Runner addRobotCheck(CLI::App& command) {
                    "load a URDF whose inertias a real body cannot have (not positive definite, or breaking the "
                    "triangle inequality), with a warning for each");
   command.add_option("--out", o->out, "also write the JSON to this file (atomically)");
+  command.add_option("--plot", o->plot,
+                     "draw each contact surface against its link's geometry (top and side views) into this folder: "
+                     "contacts.png and contacts.svg (matplotlib)");
   return [o] { return runRobotCheck(*o); };
 }
 

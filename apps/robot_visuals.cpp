@@ -24,31 +24,39 @@ RigidTransform toTransform(const urdf::Pose& pose) {
   return t;
 }
 
-/// The shape of one URDF visual, or false for a mesh (or an empty primitive).
-bool visualShape(const urdf::Visual& visual, const RigidTransform& linkInBody, VisualShape& shape) {
-  if (!visual.geometry) return false;
-  switch (visual.geometry->type) {
+/// The primitive of one URDF visual or collision element, or false for a mesh (or an empty
+/// primitive).
+bool primitiveShape(const urdf::GeometrySharedPtr& geometry, const urdf::Pose& origin, const RigidTransform& linkInBody,
+                    VisualShape& shape) {
+  if (!geometry) return false;
+  switch (geometry->type) {
     case urdf::Geometry::BOX: {
-      const auto& box = static_cast<const urdf::Box&>(*visual.geometry);
+      const auto& box = static_cast<const urdf::Box&>(*geometry);
       shape.kind = VisualShape::Kind::Box;
       shape.size = Vector3(box.dim.x, box.dim.y, box.dim.z);
       break;
     }
     case urdf::Geometry::CYLINDER: {
-      const auto& cylinder = static_cast<const urdf::Cylinder&>(*visual.geometry);
+      const auto& cylinder = static_cast<const urdf::Cylinder&>(*geometry);
       shape.kind = VisualShape::Kind::Cylinder;
       shape.size = Vector3(cylinder.radius, cylinder.length, 0.0);
       break;
     }
     case urdf::Geometry::SPHERE:
       shape.kind = VisualShape::Kind::Sphere;
-      shape.size = Vector3(static_cast<const urdf::Sphere&>(*visual.geometry).radius, 0.0, 0.0);
+      shape.size = Vector3(static_cast<const urdf::Sphere&>(*geometry).radius, 0.0, 0.0);
       break;
     default:
       return false;
   }
   if (!(shape.size.maxCoeff() > 0.0)) return false;
-  shape.placement = linkInBody * toTransform(visual.origin);
+  shape.placement = linkInBody * toTransform(origin);
+  return true;
+}
+
+/// The shape of one URDF visual, or false for a mesh (or an empty primitive).
+bool visualShape(const urdf::Visual& visual, const RigidTransform& linkInBody, VisualShape& shape) {
+  if (!primitiveShape(visual.geometry, visual.origin, linkInBody, shape)) return false;
   if (visual.material) {
     const urdf::Color& c = visual.material->color;
     shape.rgba = {c.r, c.g, c.b, c.a > 0.0 ? c.a : 1.0};
@@ -95,14 +103,71 @@ VisualShape inertiaBox(const BodyInertia& inertia, double minimumEdge) {
   return box;
 }
 
-std::vector<std::vector<VisualShape>> bodyVisualShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+namespace {
+
+urdf::ModelInterfaceSharedPtr parseUrdf(const std::filesystem::path& urdf) {
   std::ifstream in(urdf);
   if (!in) throw InputError(urdf.string() + ": cannot read the robot description");
   std::stringstream text;
   text << in.rdbuf();
-  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
+  urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
   if (!model) throw InputError(urdf.string() + ": not a URDF urdfdom can parse");
+  return model;
+}
 
+}  // namespace
+
+std::vector<std::vector<VisualShape>> bodyCollisionShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+  const urdf::ModelInterfaceSharedPtr model = parseUrdf(urdf);
+  std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
+  for (const Frame& frame : robot.frames) {
+    const urdf::LinkConstSharedPtr link = model->getLink(frame.name);
+    if (!link) throw InputError(urdf.string() + ": link '" + frame.name + "' is not in the file the robot was loaded from");
+    for (const urdf::CollisionSharedPtr& collision : link->collision_array) {
+      VisualShape shape;
+      if (collision && primitiveShape(collision->geometry, collision->origin, frame.placement, shape)) {
+        shape.source = "collision";
+        shapes[static_cast<std::size_t>(frame.body)].push_back(shape);
+      }
+    }
+  }
+  return shapes;
+}
+
+std::vector<Vector3> shapeCorners(const VisualShape& shape) {
+  Vector3 half = 0.5 * shape.size;
+  switch (shape.kind) {
+    case VisualShape::Kind::Box: break;
+    case VisualShape::Kind::Cylinder: half = Vector3(shape.size.x(), shape.size.x(), 0.5 * shape.size.y()); break;
+    case VisualShape::Kind::Sphere: half = Vector3::Constant(shape.size.x()); break;
+  }
+  std::vector<Vector3> corners;
+  for (int k = 0; k < 8; ++k)
+    corners.push_back(shape.placement.apply(Vector3((k & 1 ? 1 : -1) * half.x(), (k & 2 ? 1 : -1) * half.y(),
+                                                (k & 4 ? 1 : -1) * half.z())));
+  return corners;
+}
+
+VisualShape alignedInertiaBox(const BodyInertia& inertia, const Matrix3& axes, double minimumEdge) {
+  VisualShape box;
+  box.kind = VisualShape::Kind::Box;
+  box.source = "inertia";
+  box.placement.translation = inertia.com;
+  box.placement.rotation = axes;
+  if (!(inertia.mass > 0.0)) {
+    box.size = Vector3::Constant(minimumEdge);
+    return box;
+  }
+  const Matrix3 I = axes.transpose() * inertia.inertiaAboutCom * axes;
+  for (int i = 0; i < 3; ++i) {
+    const double squared = 6.0 * (I((i + 1) % 3, (i + 1) % 3) + I((i + 2) % 3, (i + 2) % 3) - I(i, i)) / inertia.mass;
+    box.size(i) = std::max(minimumEdge, std::sqrt(std::max(squared, 0.0)));
+  }
+  return box;
+}
+
+std::vector<std::vector<VisualShape>> bodyVisualShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+  const urdf::ModelInterfaceSharedPtr model = parseUrdf(urdf);
   std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
   for (const Frame& frame : robot.frames) {
     const urdf::LinkConstSharedPtr link = model->getLink(frame.name);

@@ -31,6 +31,19 @@ struct VisualShape {
 /// chain shows. Throws InputError naming the file when it cannot be parsed.
 std::vector<std::vector<VisualShape>> bodyVisualShapes(const std::filesystem::path& urdf, const RobotModel& robot);
 
+/// The URDF's collision boxes, cylinders and spheres of every body (indexed like robot.bodies;
+/// meshes left out: none for a body described by meshes alone), `source` "collision".
+std::vector<std::vector<VisualShape>> bodyCollisionShapes(const std::filesystem::path& urdf, const RobotModel& robot);
+
+/// The uniform box with the mass and the second moments of `inertia` about the axes `axes` (a
+/// rotation in the body frame) rather than its principal axes: a foot's box lying in its sole's
+/// plane, where the principal axes of a foot with an ankle motor in it are tilted. Its edges
+/// from the diagonal of the inertia in those axes (each at least `minimumEdge`).
+VisualShape alignedInertiaBox(const BodyInertia& inertia, const Matrix3& axes, double minimumEdge);
+
+/// The eight corners of a shape's bounding box, in the shape's parent (body) frame.
+std::vector<Vector3> shapeCorners(const VisualShape& shape);
+
 /// The uniform box with the mass and principal moments of `inertia`, in the body frame (each
 /// edge at least `minimumEdge`, for a link whose inertia is a point or a rod).
 VisualShape inertiaBox(const BodyInertia& inertia, double minimumEdge);

@@ -129,6 +129,16 @@ int runMotion(const RunOptions& o) {
     if (o.strict && !refused.empty())
       throw InputError(o.scenario + ": the robot cannot hold the fixed " + refused + " (--strict: nothing is run or written)");
   };
+  events.onTimingChecks = [&](const std::vector<TimingCheck>& checks) {
+    std::string refused;
+    for (const TimingCheck& c : checks) {
+      if (!c.tooShort()) continue;
+      std::cout << "  timing: " << c.message() << "\n";
+      refused += (refused.empty() ? "" : "; ") + c.message();
+    }
+    if (o.strict && !refused.empty())
+      throw InputError(o.scenario + ": " + refused + " (--strict: nothing is run or written)");
+  };
   events.onPosture = [&](const std::string& which, const PostureOutcome& p) {
     std::cout << "  " << which << (scenario.periodic ? " and end" : "") << " posture: " << toString(p.status) << " after "
               << p.iterations << " iterations, static power " << std::setprecision(4) << p.staticPowerBefore << " → "
@@ -295,7 +305,8 @@ Runner addRun(CLI::App& command) {
                    "triangle inequality), with a warning for each, as the scenario's allow_nonphysical_inertia: true");
   command.add_flag("--strict", o->strict,
                    "refuse a scenario whose fixed start or end posture the robot cannot hold at rest (centre of mass "
-                   "outside the support polygon, a static torque beyond its limit): exit 2, nothing written");
+                   "outside the support polygon, a static torque beyond its limit), or whose centre-of-mass task is due "
+                   "sooner than a linear inverted pendulum can get there: exit 2, nothing written");
   command.add_option("--checkpoint-seconds", o->checkpointSeconds,
                      "write the current iterate (status running) at most this often; 0: every iteration, "
                      "negative: never")

@@ -185,6 +185,11 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
     if (!check.holdable())
       record.warnings.push_back("the fixed " + check.message() + ": the robot cannot hold it at rest, so no motion of this problem is feasible");
   if (events.onPostureChecks) events.onPostureChecks(record.postureChecks);
+  record.timingChecks = checkCenterOfMassTimings(problem);
+  for (const TimingCheck& check : record.timingChecks)
+    if (check.tooShort())
+      record.warnings.push_back(check.message() + ": no motion of this problem reaches it (give the task more time or a nearer target)");
+  if (events.onTimingChecks) events.onTimingChecks(record.timingChecks);
   Eigen::VectorXd start = scenario.start, end = scenario.end;
   if (scenario.configurationOptimisation) {
     if (!scenario.fixStart) {

@@ -18,6 +18,7 @@
 #include "outer_nlp/motion_solve.hpp"
 #include "outer_nlp/motion_verification.hpp"
 #include "outer_nlp/posture_check.hpp"
+#include "outer_nlp/timing_check.hpp"
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt {
@@ -103,6 +104,9 @@ struct RunRecord {
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;
   /// The fixed postures, checked at rest before anything else (posture_check.hpp).
   std::vector<PostureCheck> postureChecks;
+  /// The centre-of-mass tasks' timings against the linear inverted pendulum's least times
+  /// (timing_check.hpp), checked before anything is optimised.
+  std::vector<TimingCheck> timingChecks;
   /// What the run should not pass over in silence (result.json `warnings`): a fixed posture the
   /// robot cannot hold, a posture whose configuration optimisation did not end optimal, …
   std::vector<std::string> warnings;
@@ -114,6 +118,9 @@ struct ScenarioRunEvents {
   /// The fixed postures have been checked (before anything is optimised); may throw to stop
   /// the run there (`mcopt run --strict` throws InputError when one cannot be held).
   std::function<void(const std::vector<PostureCheck>&)> onPostureChecks;
+  /// The centre-of-mass timings have been checked (after the postures); may throw to stop the
+  /// run (`--strict`, one too short).
+  std::function<void(const std::vector<TimingCheck>&)> onTimingChecks;
   /// A start or end posture has been optimised ("start" or "end").
   std::function<void(const std::string& which, const PostureOutcome&)> onPosture;
   std::function<void(const RunRecord::ContactPosture&)> onContactPosture;

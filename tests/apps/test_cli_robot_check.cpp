@@ -40,6 +40,14 @@ TEST_CASE("robot check: half-sitting on both feet and on one, as inverse dynamic
   const Json report = checkJson(test::quoted(kHrp2) + " --feet l_sole,r_sole");
   CHECK(report.at("feet") == Json({"l_sole", "r_sole"}));
   CHECK(report.at("checks").size() == 3 * 2);  // zero and half_sitting, each on both feet and on each
+  // The values in use for every joint, with where each came from.
+  REQUIRE(report.at("joints").size() == 30);
+  for (const Json& j : report.at("joints"))
+    if (j.at("name") == "RLEG_JOINT3") {
+      CHECK(j.at("effort").get<double>() == 250.0);
+      CHECK(j.at("sources").at("effort") == "actuator file joints.RLEG_JOINT3");
+      CHECK(j.at("sources").at("rotor_inertia") == "actuator file joints.RLEG_JOINT3");
+    }
 
   const Json& both = find(report, "half_sitting", {"l_sole", "r_sole"});
   CHECK(both.at("checked") == true);
@@ -192,4 +200,22 @@ TEST_CASE("non-physical inertias: refused by run and robot check, loaded with th
     CHECK((ran.exitCode == 0 || ran.exitCode == 4));
     CHECK_THAT(ran.errors, Contains("mcopt: warning: ") && Contains("triangle inequality"));
   }
+}
+
+TEST_CASE("robot check --plot: each contact surface drawn against its link's geometry", "[cli][robot][plot]") {
+  const test::TempDir dir;
+  const auto r = test::runMcopt("robot check " + test::quoted(kHrp2) + " --feet l_sole,r_sole --plot " +
+                                test::quoted(dir.path() / "figures"));
+  INFO(r.all());
+  REQUIRE(r.exitCode == 0);
+  for (const char* file : {"contacts.png", "contacts.svg"}) {
+    const auto path = dir.path() / "figures" / file;
+    REQUIRE(std::filesystem::exists(path));
+    CHECK(std::filesystem::file_size(path) > 10000);
+  }
+  // The SVG names every surface of robots/hrp2/contacts.yaml and where its geometry came from.
+  std::ifstream svg(dir.path() / "figures" / "contacts.svg");
+  const std::string text{std::istreambuf_iterator<char>(svg), {}};
+  for (const char* surface : {"l_sole on l_sole", "r_sole on r_sole", "l_hand on l_palm", "r_hand on r_palm"})
+    CHECK_THAT(text, Contains(surface));
 }

@@ -1207,3 +1207,38 @@ TEST_CASE("run: a posture problem stopped at its iteration cap says so, and the 
   REQUIRE(result["warnings"].size() == 1);
   CHECK_THAT(result["warnings"][0].get<std::string>(), Contains("not the static optimum"));
 }
+
+TEST_CASE("run: a centre-of-mass task due sooner than the robot can get there is reported before the run, and --strict refuses it",
+          "[cli][run]") {
+  // The bundled weight shift four times faster: its three targets 0.15 s apart, where a linear
+  // inverted pendulum of HRP-2's height needs about 0.2 s (outer_nlp/timing_check.hpp).
+  const test::TempDir dir;
+  const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    for (std::size_t k = 0; k < 3; ++k) root["tasks"][k]["time"] = 0.15 * static_cast<double>(k + 1);
+  }, "fast.yaml");
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 0");
+  INFO(r.all());
+  CHECK(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains("timing: task 'centre of mass above the left sole' (t = 0.15 s): 0.15 s after the start posture at rest, "
+                                "the centre of mass needs at least 0.227 s") &&
+                           Contains("too short for this robot"));
+  const Json result = readJson(out / "result.json");
+  int timing = 0;
+  for (const Json& w : result["warnings"]) timing += w.get<std::string>().find("needs at least") != std::string::npos;
+  CHECK(timing == 3);
+
+  const auto refused = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(dir.path() / "refused") + " --strict");
+  CHECK(refused.exitCode == 2);
+  CHECK_THAT(refused.errors, Contains("needs at least") && Contains("--strict: nothing is run or written"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "refused" / "result.json"));
+
+  // The bundled timings pass: no timing line.
+  const auto bundled = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+  }, "bundled.yaml");
+  const auto ok = test::runMcopt("run " + test::quoted(bundled) + " --out " + test::quoted(dir.path() / "ok") + " --max-iterations 0");
+  CHECK(ok.exitCode == 4);
+  CHECK_THAT(ok.output, !Contains("timing:"));
+}

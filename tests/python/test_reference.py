@@ -52,7 +52,7 @@ def test_every_mcopt_flag_named_in_the_docs_exists():
     # `mcopt run --flag` written anywhere in the docs must be a flag of that command.
     flags = cli_reference.inventory(cli_reference.page(EXE))
     pages = [SOURCE / "README.md"] + sorted((SOURCE / "docs").rglob("*.md"))
-    pattern = re.compile(r"mcopt ((?:robot info|robot check|study collect|study case|[a-z]+))\b([^`\n|]*)")
+    pattern = re.compile(r"mcopt ((?:robot info|robot check|robot init|study collect|study case|[a-z]+))\b([^`\n|]*)")
     problems = []
     for page in pages:
         if "lab-notes" in page.parts:
