@@ -64,7 +64,13 @@ TEST_CASE("verify: with one instant an interval, the rows it checks are the prob
 TEST_CASE("verify: a spline parameter nudged so that a torque limit breaks between two samples only", "[outer][verify]") {
   const Scenario s = coarseKick();
   MotionProblem problem(s);
-  const Scenario fineScenario = fineGridScenario(s, 10);  // MotionProblem keeps a reference to its scenario
+  // The search's grid (MotionProblem keeps a reference to its scenario): 5 instants an interval
+  // under the sanitizers, where its hundreds of evaluations took a minute; verify's own is 10.
+#ifdef MCOPT_UNDER_SANITIZERS
+  const Scenario fineScenario = fineGridScenario(s, 5);
+#else
+  const Scenario fineScenario = fineGridScenario(s, 10);
+#endif
   MotionProblem fine(fineScenario);
   const Eigen::VectorXd x0 = problem.initialPoint(s.start, s.end);
   const int m = problem.parametrization().parametersPerJoint();
