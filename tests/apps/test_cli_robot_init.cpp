@@ -213,7 +213,8 @@ TEST_CASE("robot init: Romeo's non-physical inertias need the flag, which its st
   const auto check = test::runMcopt("robot check " + test::quoted(out) + " --allow-nonphysical-inertia --json");
   INFO(check.all());
   REQUIRE(check.exitCode == 0);
-  for (const Json& c : Json::parse(check.output).at("checks"))
+  const Json report = Json::parse(check.output);  // held: the loop reads into it
+  for (const Json& c : report.at("checks"))
     if (c.at("posture") == "standing" && c.at("support").size() == 2) CHECK(c.at("holdable") == true);
 }
 #endif
