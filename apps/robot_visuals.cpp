@@ -82,25 +82,11 @@ bool linkCylinder(const Vector3& from, const Vector3& to, double radius, VisualS
 }  // namespace
 
 VisualShape inertiaBox(const BodyInertia& inertia, double minimumEdge) {
-  VisualShape box;
-  box.kind = VisualShape::Kind::Box;
-  box.source = "inertia";
-  box.placement.translation = inertia.com;
-  if (!(inertia.mass > 0.0)) {
-    box.size = Vector3::Constant(minimumEdge);
-    return box;
-  }
-  // A uniform box of edges a, b, c has I_x = m (b² + c²) / 12, …, so a² = 6 (I_y + I_z − I_x) / m.
+  // Along the principal axes, where the inertia is diagonal: its eigenvalues.
   const Eigen::SelfAdjointEigenSolver<Matrix3> principal(0.5 * (inertia.inertiaAboutCom + inertia.inertiaAboutCom.transpose()));
-  const Vector3 I = principal.eigenvalues();
   Matrix3 axes = principal.eigenvectors();
   if (axes.determinant() < 0.0) axes.col(2) = -axes.col(2);
-  for (int i = 0; i < 3; ++i) {
-    const double squared = 6.0 * (I((i + 1) % 3) + I((i + 2) % 3) - I(i)) / inertia.mass;
-    box.size(i) = std::max(minimumEdge, std::sqrt(std::max(squared, 0.0)));
-  }
-  box.placement.rotation = axes;
-  return box;
+  return alignedInertiaBox(inertia, inertia.mass > 0.0 ? axes : Matrix3::Identity(), minimumEdge);
 }
 
 namespace {
@@ -158,6 +144,8 @@ VisualShape alignedInertiaBox(const BodyInertia& inertia, const Matrix3& axes, d
     box.size = Vector3::Constant(minimumEdge);
     return box;
   }
+  // A uniform box of edges a, b, c has I_x = m (b² + c²) / 12, …, so a² = 6 (I_y + I_z − I_x) / m,
+  // with the inertia's diagonal along `axes`.
   const Matrix3 I = axes.transpose() * inertia.inertiaAboutCom * axes;
   for (int i = 0; i < 3; ++i) {
     const double squared = 6.0 * (I((i + 1) % 3, (i + 1) % 3) + I((i + 2) % 3, (i + 2) % 3) - I(i, i)) / inertia.mass;
