@@ -117,10 +117,9 @@ SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, c
        << "reference_body: " << Json(robot.frames[static_cast<std::size_t>(reference.frame)].name).dump() << "\n";
   // The surface's link placed so that the surface lies at the origin.
   const RigidTransform link = reference.placement.inverse();
-  const Matrix3& R = link.rotation;
+  const Vector3 rpy = rpyFromRotation(link.rotation);
   yaml << std::setprecision(17) << "reference_pose: {position: [" << link.translation.x() << ", " << link.translation.y()
-       << ", " << link.translation.z() << "], rpy: [" << std::atan2(R(2, 1), R(2, 2)) << ", "
-       << std::asin(std::clamp(-R(2, 0), -1.0, 1.0)) << ", " << std::atan2(R(1, 0), R(0, 0)) << "]}\n"
+       << ", " << link.translation.z() << "], rpy: [" << rpy.x() << ", " << rpy.y() << ", " << rpy.z() << "]}\n"
        << "contacts: " << Json(support).dump() << "\n";
   if (support.size() > 1) yaml << "contact_forces: bilevel\ninner: {solver: active-set, contact_model: wrench-cone}\n";
   yaml << "duration: 1.0\nsamples: 5\ncontrol_points: 7\n"
@@ -206,15 +205,10 @@ Json contactGeometryJson(const RobotModel& robot, const std::string& urdf, const
   for (const ContactSurface& s : surfaces) {
     const Frame& frame = robot.frames[static_cast<std::size_t>(s.frame)];
     const std::size_t body = static_cast<std::size_t>(frame.body);
-    std::vector<VisualShape> shapes = collisions[body];
-    std::string source = "collision primitives";
-    // Body frame → surface frame.
+    // Body frame → surface frame; as `robot init` estimates a sole, an inertia box along the surface.
     const RigidTransform surfaceInBody = frame.placement * s.placement;
-    if (shapes.empty()) {
-      // As `robot init` estimates a sole: the inertia's box along the surface's axes.
-      shapes.push_back(alignedInertiaBox(robot.bodies[body].inertia, surfaceInBody.rotation, 0.01));
-      source = "inertia box along the surface (no primitive in the URDF)";
-    }
+    std::string source;
+    const std::vector<VisualShape> shapes = bodyGeometryShapes(robot, collisions, frame.body, surfaceInBody.rotation, source);
     const RigidTransform toSurface = surfaceInBody.inverse();
     Json boxes = Json::array();
     for (const VisualShape& shape : shapes) {

@@ -43,12 +43,6 @@ std::string vector3(const Vector3& v) {
   return "[" + number(v.x(), 6) + ", " + number(v.y(), 6) + ", " + number(v.z(), 6) + "]";
 }
 
-Vector3 rpyOf(const Matrix3& R) {
-  // R = Rz(yaw) Ry(pitch) Rx(roll), as rotationFromRpy builds it.
-  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
-  return Vector3(std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0)));
-}
-
 std::string quoted(const std::string& s) { return Json(s).dump(); }
 
 /// The robot at its zero posture, its root body's frame the world.
@@ -63,20 +57,14 @@ struct ZeroPosture {
   RigidTransform body(int b) const { return frame(model.robot().findFrame(model.robot().bodies[static_cast<std::size_t>(b)].name)); }
 };
 
-/// Points of a body's geometry in its frame: its collision primitives' corners, or the corners
-/// of the uniform box with its inertia along `axes` (body frame); `what` says which.
+/// Points of a body's geometry in its frame: the corners of bodyGeometryShapes (its collision
+/// primitives, or its inertia's box along `axes`); `what` says which.
 std::vector<Vector3> bodyGeometry(const RobotModel& robot, const std::vector<std::vector<VisualShape>>& collisions, int body,
                                   std::string& what, const Matrix3& axes = Matrix3::Identity()) {
   std::vector<Vector3> points;
-  for (const VisualShape& shape : collisions[static_cast<std::size_t>(body)])
+  for (const VisualShape& shape : bodyGeometryShapes(robot, collisions, body, axes, what))
     for (const Vector3& c : shapeCorners(shape)) points.push_back(c);
-  if (!points.empty()) {
-    what = "the collision primitives of " + robot.bodies[static_cast<std::size_t>(body)].name;
-    return points;
-  }
-  what = "the uniform box with the inertia of " + robot.bodies[static_cast<std::size_t>(body)].name +
-         " (its URDF geometry is meshes or nothing)";
-  return shapeCorners(alignedInertiaBox(robot.bodies[static_cast<std::size_t>(body)].inertia, axes, 0.01));
+  return points;
 }
 
 /// The words of a name, split at _ - . and lower-cased: "l_sole" → {"l", "sole"}.
@@ -120,16 +108,20 @@ std::vector<int> chainToRoot(const RobotModel& robot, int body) {
 ContactEstimate findSole(const RobotModel& robot, const ZeroPosture& zero,
                          const std::vector<std::vector<VisualShape>>& collisions, int body, const std::string& name,
                          double leftSign, std::vector<std::string>& notes) {
-  // The inertia box (where the foot has no primitives) lies along the sole: the axes of a
-  // horizontal *sole* link, else the ground's (x forward, y left) at the zero posture.
+  // The URDF's sole link: fixed to the foot, named *sole*, horizontal at the zero posture.
+  int soleLink = -1;
+  for (std::size_t f = 0; f < robot.frames.size() && soleLink < 0; ++f) {
+    if (robot.frames[f].body != body || lower(robot.frames[f].name).find("sole") == std::string::npos) continue;
+    if (zero.frame(static_cast<int>(f)).rotation(2, 2) >= std::cos(0.02)) soleLink = static_cast<int>(f);
+    else notes.push_back("the link " + robot.frames[f].name + " is not horizontal at the zero posture: not used as the sole");
+  }
+  // The inertia box (where the foot has no primitives) lies along the sole: the sole link's
+  // axes, else the ground's (x forward, y left; the root's turned half a turn where its y
+  // points right) at the zero posture.
   const RigidTransform bodyPose = zero.body(body);
-  Matrix3 groundAxes = leftSign > 0.0 ? Matrix3::Identity() : Matrix3(Eigen::AngleAxisd(std::numbers::pi, Vector3::UnitZ()));
-  for (std::size_t f = 0; f < robot.frames.size(); ++f)
-    if (robot.frames[f].body == body && lower(robot.frames[f].name).find("sole") != std::string::npos &&
-        zero.frame(static_cast<int>(f)).rotation(2, 2) >= std::cos(0.02)) {
-      groundAxes = zero.frame(static_cast<int>(f)).rotation;
-      break;
-    }
+  const Matrix3 groundAxes = soleLink >= 0  ? zero.frame(soleLink).rotation
+                             : leftSign > 0 ? Matrix3::Identity()
+                                            : Matrix3(Eigen::AngleAxisd(std::numbers::pi, Vector3::UnitZ()));
   std::string geometry;
   const std::vector<Vector3> local = bodyGeometry(robot, collisions, body, geometry, bodyPose.rotation.transpose() * groundAxes);
   std::vector<Vector3> world;
@@ -141,28 +133,21 @@ ContactEstimate findSole(const RobotModel& robot, const ZeroPosture& zero,
   estimate.surface.name = name;
   estimate.surface.friction = 0.7;
   RigidTransform soleWorld;
-  for (std::size_t f = 0; f < robot.frames.size(); ++f) {
-    if (robot.frames[f].body != body || lower(robot.frames[f].name).find("sole") == std::string::npos) continue;
-    const RigidTransform pose = zero.frame(static_cast<int>(f));
-    if (pose.rotation(2, 2) < std::cos(0.02)) {
-      notes.push_back("the link " + robot.frames[f].name + " is not horizontal at the zero posture: not used as the sole");
-      continue;
-    }
-    estimate.link = robot.frames[f].name;
-    estimate.surface.frame = static_cast<int>(f);
+  if (soleLink >= 0) {
+    const RigidTransform pose = zero.frame(soleLink);
+    estimate.link = robot.frames[static_cast<std::size_t>(soleLink)].name;
+    estimate.surface.frame = soleLink;
     estimate.surface.placement = RigidTransform::identity();
     soleWorld = pose;
     estimate.source = "the URDF's sole link " + estimate.link;
     if (std::abs(pose.translation.z() - bottom) > 0.01)
       notes.push_back("the sole link " + estimate.link + " lies " + number(100.0 * (pose.translation.z() - bottom), 3) +
                       " cm above the lowest point of " + geometry);
-    break;
   }
   if (estimate.link.empty()) {
     // A frame at the bottom of the geometry, under its footprint's centre, world-aligned.
     double xMin = 1e9, xMax = -1e9, yMin = 1e9, yMax = -1e9;
     for (const Vector3& p : world) xMin = std::min(xMin, p.x()), xMax = std::max(xMax, p.x()), yMin = std::min(yMin, p.y()), yMax = std::max(yMax, p.y());
-    // x forward, y left: the root's axes, turned half a turn where its y points right.
     soleWorld.rotation = groundAxes;
     soleWorld.translation = Vector3(0.5 * (xMin + xMax), 0.5 * (yMin + yMax), bottom);
     estimate.link = robot.bodies[static_cast<std::size_t>(body)].name;
@@ -326,7 +311,7 @@ std::string contactsYaml(const RobotModel& robot, const std::vector<ContactEstim
     y << "  # " << c.surface.name << ": " << c.source << "\n"
       << "  " << s.name << ": {link: " << quoted(c.link);
     if (!s.placement.translation.isZero(1e-12)) y << ", position: " << vector3(s.placement.translation);
-    if (!s.placement.rotation.isIdentity(1e-12)) y << ", rpy: " << vector3(rpyOf(s.placement.rotation));
+    if (!s.placement.rotation.isIdentity(1e-12)) y << ", rpy: " << vector3(rpyFromRotation(s.placement.rotation));
     y << ", rectangle: [" << number(s.xMin, 4) << ", " << number(s.xMax, 4) << ", " << number(s.yMin, 4) << ", "
       << number(s.yMax, 4) << "], friction: " << s.friction << "}\n";
   }
@@ -371,7 +356,7 @@ std::string scenarioHeader(const std::string& description, const std::string& ur
     << "contact_surfaces: ../contacts.yaml\n"
     << "postures: ../postures.yaml\n"
     << "reference_body: " << quoted(left.link) << "   # the link of the left sole\n"
-    << "reference_pose: {position: " << vector3(linkPose.translation) << ", rpy: " << vector3(rpyOf(linkPose.rotation))
+    << "reference_pose: {position: " << vector3(linkPose.translation) << ", rpy: " << vector3(rpyFromRotation(linkPose.rotation))
     << "}   # the sole at the origin\n";
   if (allowNonPhysicalInertia)
     y << "allow_nonphysical_inertia: true   # as `robot init --allow-nonphysical-inertia` read the URDF: fix its inertias when you can\n";

@@ -101,23 +101,42 @@ urdf::ModelInterfaceSharedPtr parseUrdf(const std::filesystem::path& urdf) {
   return model;
 }
 
-}  // namespace
-
-std::vector<std::vector<VisualShape>> bodyCollisionShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+/// `visit(frame, link)` for every frame of `robot` and its urdfdom link.
+template <class Visit>
+void forEachLink(const std::filesystem::path& urdf, const RobotModel& robot, Visit visit) {
   const urdf::ModelInterfaceSharedPtr model = parseUrdf(urdf);
-  std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
   for (const Frame& frame : robot.frames) {
     const urdf::LinkConstSharedPtr link = model->getLink(frame.name);
     if (!link) throw InputError(urdf.string() + ": link '" + frame.name + "' is not in the file the robot was loaded from");
-    for (const urdf::CollisionSharedPtr& collision : link->collision_array) {
+    visit(frame, *link);
+  }
+}
+
+}  // namespace
+
+std::vector<std::vector<VisualShape>> bodyCollisionShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
+  std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
+  forEachLink(urdf, robot, [&](const Frame& frame, const urdf::Link& link) {
+    for (const urdf::CollisionSharedPtr& collision : link.collision_array) {
       VisualShape shape;
       if (collision && primitiveShape(collision->geometry, collision->origin, frame.placement, shape)) {
         shape.source = "collision";
         shapes[static_cast<std::size_t>(frame.body)].push_back(shape);
       }
     }
-  }
+  });
   return shapes;
+}
+
+std::vector<VisualShape> bodyGeometryShapes(const RobotModel& robot, const std::vector<std::vector<VisualShape>>& collisions,
+                                            int body, const Matrix3& axes, std::string& what) {
+  const std::size_t b = static_cast<std::size_t>(body);
+  if (!collisions[b].empty()) {
+    what = "the collision primitives of " + robot.bodies[b].name;
+    return collisions[b];
+  }
+  what = "the uniform box with the inertia of " + robot.bodies[b].name + " (its URDF geometry is meshes or nothing)";
+  return {alignedInertiaBox(robot.bodies[b].inertia, axes, 0.01)};
 }
 
 std::vector<Vector3> shapeCorners(const VisualShape& shape) {
@@ -155,16 +174,13 @@ VisualShape alignedInertiaBox(const BodyInertia& inertia, const Matrix3& axes, d
 }
 
 std::vector<std::vector<VisualShape>> bodyVisualShapes(const std::filesystem::path& urdf, const RobotModel& robot) {
-  const urdf::ModelInterfaceSharedPtr model = parseUrdf(urdf);
   std::vector<std::vector<VisualShape>> shapes(robot.bodies.size());
-  for (const Frame& frame : robot.frames) {
-    const urdf::LinkConstSharedPtr link = model->getLink(frame.name);
-    if (!link) throw InputError(urdf.string() + ": link '" + frame.name + "' is not in the file the robot was loaded from");
-    for (const urdf::VisualSharedPtr& visual : link->visual_array) {
+  forEachLink(urdf, robot, [&](const Frame& frame, const urdf::Link& link) {
+    for (const urdf::VisualSharedPtr& visual : link.visual_array) {
       VisualShape shape;
       if (visual && visualShape(*visual, frame.placement, shape)) shapes[static_cast<std::size_t>(frame.body)].push_back(shape);
     }
-  }
+  });
   for (std::size_t b = 0; b < robot.bodies.size(); ++b) {
     if (!shapes[b].empty()) continue;
     // Drawn from dynamics alone: the inertia box, and a cylinder to each joint the body

@@ -41,6 +41,12 @@ std::vector<std::vector<VisualShape>> bodyCollisionShapes(const std::filesystem:
 /// from the diagonal of the inertia in those axes (each at least `minimumEdge`).
 VisualShape alignedInertiaBox(const BodyInertia& inertia, const Matrix3& axes, double minimumEdge);
 
+/// The geometry of body `body` (an index of robot.bodies): its collision primitives
+/// (`collisions`, from bodyCollisionShapes), or where it has none the box of its inertia along
+/// `axes` (body frame). `what` says which, naming the body.
+std::vector<VisualShape> bodyGeometryShapes(const RobotModel& robot, const std::vector<std::vector<VisualShape>>& collisions,
+                                            int body, const Matrix3& axes, std::string& what);
+
 /// The eight corners of a shape's bounding box, in the shape's parent (body) frame.
 std::vector<Vector3> shapeCorners(const VisualShape& shape);
 

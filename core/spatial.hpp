@@ -4,6 +4,9 @@
 // Rotations are matrices internally (formulation.md §1); files use quaternions
 // written [x, y, z, w] or URDF roll-pitch-yaw, converted here.
 
+#include <algorithm>
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -48,6 +51,12 @@ inline Matrix3 rotationFromRpy(double roll, double pitch, double yaw) {
   return (Eigen::AngleAxisd(yaw, Vector3::UnitZ()) * Eigen::AngleAxisd(pitch, Vector3::UnitY()) *
           Eigen::AngleAxisd(roll, Vector3::UnitX()))
       .toRotationMatrix();
+}
+
+/// The roll, pitch and yaw of `R` (rotationFromRpy's inverse; pitch in [−π/2, π/2]).
+inline Vector3 rpyFromRotation(const Matrix3& R) {
+  const double pitch = std::asin(std::clamp(-R(2, 0), -1.0, 1.0));
+  return Vector3(std::atan2(R(2, 1), R(2, 2)), pitch, std::atan2(R(1, 0), R(0, 0)));
 }
 
 /// Quaternion given as [x, y, z, w]; it is normalised (a zero quaternion is rejected by callers).
