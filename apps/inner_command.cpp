@@ -2,6 +2,7 @@
 // `mcopt inner`: solve inner contact-force problems given as data (formulation.md §7), one
 // per time sample, with a chosen solver and contact model. Formats: docs/theory/inner-problem.md.
 #include <iostream>
+#include <optional>
 #include <map>
 
 #include "apps/commands.hpp"
@@ -18,7 +19,7 @@ namespace {
 struct InnerOptions {
   std::string problems, out, solver = "active-set", contactModel = "report", kktBackend = "dense";
   bool sensitivity = false;
-  int pyramidFacets = 8;
+  std::optional<int> pyramidFacets;
   double tikhonov = 1e-9;
   bool cold = false;
   bool polish = false;
@@ -35,8 +36,7 @@ int runInner(const InnerOptions& o) {
   const Json& problems = required(file, input, "(top level)", "problems");
   if (!problems.is_array()) throw InputError(file.string() + ": problems: expected a list");
   ContactProblemSettings settings;
-  settings.model = parseContactModel(o.contactModel);
-  settings.pyramidFacets = o.pyramidFacets;
+  settings.model = parseContactModel(o.contactModel, o.pyramidFacets);
   settings.tikhonov = o.tikhonov;
   InnerSettings solverSettings;
   solverSettings.warmStart = !o.cold;
@@ -96,8 +96,10 @@ Runner addInner(CLI::App& app) {
   std::string solvers;
   for (const InnerSolverEntry& e : innerSolvers()) solvers += "; " + e.name + ": " + e.description;
   app.add_option("--solver", o->solver, "the inner solver, default active-set" + solvers);
-  app.add_option("--contact-model", o->contactModel, "report (default), pyramid or wrench-cone");
-  app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8)");
+  std::string models;
+  for (const ContactModelEntry& e : contactModels()) models += "; " + e.name + ": " + e.description;
+  app.add_option("--contact-model", o->contactModel, "the contact model, default report" + models);
+  app.add_option("--pyramid-facets", o->pyramidFacets, "facets of the pyramid model (default 8; only with --contact-model pyramid)");
   app.add_option("--tikhonov", o->tikhonov, "ε added to the objective's Hessian diagonal (default 1e-9)");
   app.add_flag("--cold", o->cold, "do not warm-start each problem from the previous one's result");
   app.add_flag("--polish", o->polish,

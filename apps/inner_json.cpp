@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "apps/inner_json.hpp"
 
+#include <algorithm>
+
 #include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt::cli {
@@ -59,11 +61,17 @@ InnerProblemData readInnerProblem(const std::filesystem::path& file, const Json&
   return d;
 }
 
-ContactModel parseContactModel(const std::string& name) {
-  if (name == "report") return ContactModel::Report;
-  if (name == "pyramid") return ContactModel::Pyramid;
-  if (name == "wrench-cone") return ContactModel::WrenchCone;
-  throw InputError("--contact-model: expected report, pyramid or wrench-cone; got '" + name + "'");
+std::shared_ptr<const ContactModel> parseContactModel(const std::string& name, std::optional<int> pyramidFacets) {
+  const auto& names = contactModelNames();
+  if (std::find(names.begin(), names.end(), name) == names.end())
+    throw InputError("--contact-model: expected " + contactModelList() + "; got '" + name + "'");
+  ContactModelOptions options;
+  if (pyramidFacets) {
+    if (name != "pyramid")
+      throw InputError("pyramid facets: only the pyramid contact model has facets (the contact model is " + name + ")");
+    options.pyramidFacets = *pyramidFacets;
+  }
+  return makeContactModel(name, options);
 }
 
 Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
@@ -82,7 +90,7 @@ Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
   if (!p.cones.empty()) {
     Json cones = Json::object();
     for (std::size_t k = 0; k < p.cones.size(); ++k)
-      cones[p.contactNames[static_cast<std::size_t>(p.cones[k].index / 6)]] =
+      cones[p.contactNames[static_cast<std::size_t>(p.cones[k].contact)]] =
           json_io::toJson(r.coneMultipliers.segment<3>(3 * static_cast<Eigen::Index>(k)));
     multipliers["cones"] = cones;
   }
@@ -91,7 +99,7 @@ Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
   const auto rowCount = static_cast<int>(p.inequality.rows());
   for (int a : r.activeSet)
     active.push_back(a < rowCount ? p.rowNames[static_cast<std::size_t>(a)]
-                                  : p.contactNames[static_cast<std::size_t>(p.cones[static_cast<std::size_t>(a - rowCount)].index / 6)] +
+                                  : p.contactNames[static_cast<std::size_t>(p.cones[static_cast<std::size_t>(a - rowCount)].contact)] +
                                         ".cone");
   out["active_set"] = active;
   out["iterations"] = r.iterations;

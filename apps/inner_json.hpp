@@ -4,6 +4,7 @@
 // problem and the one writer of a result, for `mcopt inner` and the Python module alike.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +26,10 @@ struct InnerProblemData {
 /// Reads one problem object; errors name `file` and `field` (e.g. problems[3].tau0).
 InnerProblemData readInnerProblem(const std::filesystem::path& file, const json_io::Json& node, const std::string& field);
 
-/// "report", "pyramid" or "wrench-cone"; InputError otherwise.
-ContactModel parseContactModel(const std::string& name);
+/// A registered contact model (contactModels()) by name, with the pyramid's facets when given;
+/// InputError naming --contact-model and the registered ones otherwise, or facets given to
+/// another model.
+std::shared_ptr<const ContactModel> parseContactModel(const std::string& name, std::optional<int> pyramidFacets = {});
 
 /// status, wrenches, objective, multipliers (balance, named rows, cones), active_set (row
 /// names), iterations, kkt_residual, solve_time_us, balance_slack, message.

@@ -23,10 +23,10 @@ void addInnerCounters(benchmark::State& state, const MultiContactResult& r) {
   state.counters["failed"] = r.failedSamples;
 }
 
-void innerSolve(benchmark::State& state, const std::string& solver, ContactModel model, int contacts) {
+void innerSolve(benchmark::State& state, const std::string& solver, const std::string& model, int contacts) {
   const Hrp2Motion motion;
   MultiContactSettings settings;
-  settings.problem.model = model;
+  settings.problem.model = makeContactModel(model);
   MultiContactEvaluator evaluator(motion.model, loadActuators(kHrp2 / "actuators.yaml", motion.robot),
                                   SampledTrajectory(motion.parametrization, 100), motion.contacts(contacts), settings);
   MultiContactResult reference;
@@ -72,14 +72,12 @@ void bilevelDynamics(benchmark::State& state, int contacts, const std::string& s
 }  // namespace
 
 void registerInnerBenchmarks() {
-  const std::vector<std::pair<const char*, ContactModel>> models = {
-      {"report", ContactModel::Report}, {"pyramid", ContactModel::Pyramid}, {"wrench-cone", ContactModel::WrenchCone}};
   for (const char* solver : {"active-set", "active-set-cold", "slsqp", "ipopt"})
-    for (const auto& [modelName, model] : models)
+    for (const std::string& modelName : contactModelNames())
       for (int contacts : {2, 3, 4})
         benchmark::RegisterBenchmark(
             ("Inner/" + std::string(solver) + "/" + modelName + "/" + std::to_string(contacts)).c_str(), innerSolve,
-            std::string(solver), model, contacts)
+            std::string(solver), modelName, contacts)
             ->Unit(benchmark::kMicrosecond);
   // The active-set method under the plain name (the figure earlier tables quote), the NLP
   // solvers with theirs.

@@ -122,7 +122,7 @@ SqpOutcome ActiveSetSolver::runSqp(const ContactProblem& p, DualActiveSetQp& qp,
   qp.inequalityBound.head(rows) = p.inequalityBound;
   qp.inequalityCount = rows + kSlots * cones_ + extraRows;
   const double violationTolerance = 1e-13;
-  const double dataScale = inner_detail::dataScale(p);
+  const double dataScale = p.dataScale();
   for (int sqp = 0; sqp < kMaxSqpIterations; ++sqp) {
     const double forceScale = 1.0 + x_.cwiseAbs().maxCoeff();
     qp.hessian = baseHessian;
@@ -226,7 +226,7 @@ void ActiveSetSolver::solve(const ContactProblem& p, InnerResult& r) {
   const auto start = std::chrono::steady_clock::now();
   resize(p);
   const int n = variables_;
-  const double scale = inner_detail::dataScale(p);
+  const double scale = p.dataScale();
   // Warm start (formulation.md §7): the previous sample's wrenches give the linearisation
   // points and the curvature, its active set the QP's first working set.
   const bool warm = settings_.warmStart && r.wrenches.size() == n && r.wrenches.allFinite() &&

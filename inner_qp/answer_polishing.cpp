@@ -118,7 +118,7 @@ std::optional<Polishing> polishOnActiveSet(const ContactProblem& p, BalanceMode 
   std::vector<int> held;
   for (const int row : before.activeSet)
     if (before.inequalityMultipliers[row] > 1e-6 * (1.0 + largest)) held.push_back(row);
-  const double rowSlack = settings.tolerance * dataScale(p);
+  const double rowSlack = settings.tolerance * p.dataScale();
   Eigen::VectorXd best;
   double bestResidual = residualBefore;
   std::optional<RunOutcome> bestCrossed;  // the crossover's outcome, when it is the best

@@ -2,7 +2,6 @@
 #include "inner_qp/contact_problem.hpp"
 
 #include <cmath>
-#include <numbers>
 
 #include "core/contact_maps.hpp"
 #include "core/errors.hpp"
@@ -10,9 +9,6 @@
 namespace mcopt {
 
 namespace {
-
-// Wrench components within one contact's 6 columns.
-enum { Fx = 0, Fy, Fz, Mx, My, Mz };
 
 void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const Eigen::MatrixXd>& wrenchToTorque,
               const Eigen::Ref<const Eigen::VectorXd>& tau0, const Vector6& balanceWrench,
@@ -30,8 +26,7 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
       !linear.allFinite())
     throw InputError("inner problem data contain NaN or infinity");
   if ((weights.array() <= 0.0).any()) throw InputError("torque_weights: must all be positive");
-  if (settings.model == ContactModel::Pyramid && settings.pyramidFacets < 3)
-    throw InputError("pyramid facets: need at least 3, got " + std::to_string(settings.pyramidFacets));
+  if (!settings.model) throw InputError("inner problem: no contact model");
   if (!(settings.tikhonov >= 0.0)) throw InputError("tikhonov: must be non-negative");
   for (const ContactSpec& c : contacts) {
     const std::string where = "contact '" + c.name + "': ";
@@ -44,88 +39,7 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
   }
 }
 
-/// Appends one row a·F ≤ bound over one contact's 6 wrench components.
-struct RowWriter {
-  ContactModelRows& out;
-  Eigen::Index next = 0;
-  void add(std::string name, ContactRowKind kind, std::initializer_list<std::pair<int, double>> terms,
-           double bound = 0.0) {
-    out.names[static_cast<std::size_t>(next)] = std::move(name);
-    out.kinds[static_cast<std::size_t>(next)] = kind;
-    out.rows.row(next).setZero();
-    for (const auto& [component, value] : terms) out.rows(next, component) += value;
-    out.bound[next] = bound;
-    ++next;
-  }
-};
-
 }  // namespace
-
-int contactModelRowCount(const ContactProblemSettings& s) {
-  switch (s.model) {
-    case ContactModel::Report: return 5;                        // fz ≥ f_min, 4 CoP rows
-    case ContactModel::Pyramid: return 5 + s.pyramidFacets;      // + facets
-    case ContactModel::WrenchCone: return 5 + 4 + 8;             // + |fx|,|fy| ≤ μ fz, 8 yaw rows
-  }
-  return 0;
-}
-
-ContactModelRows contactModelRows(const ContactSpec& c, const ContactProblemSettings& settings) {
-  if (settings.model == ContactModel::Pyramid && settings.pyramidFacets < 3)
-    throw InputError("pyramid facets: need at least 3, got " + std::to_string(settings.pyramidFacets));
-  const int count = contactModelRowCount(settings);
-  ContactModelRows out;
-  out.rows.resize(count, 6);
-  out.bound.resize(count);
-  out.names.resize(static_cast<std::size_t>(count));
-  out.kinds.resize(static_cast<std::size_t>(count));
-  RowWriter rows{out};
-  using K = ContactRowKind;
-  rows.add("fz_min", K::NormalForce, {{Fz, -1.0}}, -c.minNormalForce);  // fz ≥ f_min
-  rows.add("cop_x_max", K::CenterOfPressure, {{My, -1.0}, {Fz, -c.xMax}});    // −m_y ≤ x_max fz
-  rows.add("cop_x_min", K::CenterOfPressure, {{My, 1.0}, {Fz, c.xMin}});      // x_min fz ≤ −m_y
-  rows.add("cop_y_max", K::CenterOfPressure, {{Mx, 1.0}, {Fz, -c.yMax}});     // m_x ≤ y_max fz
-  rows.add("cop_y_min", K::CenterOfPressure, {{Mx, -1.0}, {Fz, c.yMin}});     // y_min fz ≤ m_x
-  switch (settings.model) {
-    case ContactModel::Report: break;  // the friction cone is a second-order cone, not a row
-    case ContactModel::Pyramid: {
-      const int k = settings.pyramidFacets;
-      const double inscribed = c.friction * std::cos(std::numbers::pi / k);
-      for (int f = 0; f < k; ++f) {
-        const double theta = 2.0 * std::numbers::pi * f / k;
-        rows.add("facet_" + std::to_string(f), K::Friction, {{Fx, std::cos(theta)}, {Fy, std::sin(theta)}, {Fz, -inscribed}});
-      }
-      break;
-    }
-    case ContactModel::WrenchCone: {
-      // About the rectangle's centre (cx, cy): m'_x = m_x − cy fz, m'_y = m_y + cx fz,
-      // m'_z = m_z − cx fy + cy fx. With μ̃ = μ/√2 the pyramid |fx|, |fy| ≤ μ̃ fz is
-      // inscribed in the circular cone (Caron et al. §III), so the wrench cone admits
-      // nothing the report model forbids and forbids, besides, the yaw slip.
-      const double mu = c.friction / std::numbers::sqrt2;
-      const double cx = 0.5 * (c.xMin + c.xMax), cy = 0.5 * (c.yMin + c.yMax);
-      const double X = 0.5 * (c.xMax - c.xMin), Y = 0.5 * (c.yMax - c.yMin);
-      rows.add("fx_max", K::Friction, {{Fx, 1.0}, {Fz, -mu}});
-      rows.add("fx_min", K::Friction, {{Fx, -1.0}, {Fz, -mu}});
-      rows.add("fy_max", K::Friction, {{Fy, 1.0}, {Fz, -mu}});
-      rows.add("fy_min", K::Friction, {{Fy, -1.0}, {Fz, -mu}});
-      int yaw = 0;
-      for (double s1 : {-1.0, 1.0})
-        for (double s2 : {-1.0, 1.0}) {
-          // m'_z ≤ μ(X+Y) fz − s1 (Y fx + μ m'_x) − s2 (X fy + μ m'_y)
-          rows.add("yaw_max_" + std::to_string(yaw), K::Yaw, {{Mz, 1.0}, {Fy, -cx}, {Fx, cy},
-                       {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, s1 * mu}, {Fz, -s1 * mu * cy},
-                       {Fy, s2 * X}, {My, s2 * mu}, {Fz, s2 * mu * cx}});
-          // −m'_z ≤ μ(X+Y) fz − s1 (Y fx − μ m'_x) − s2 (X fy − μ m'_y)
-          rows.add("yaw_min_" + std::to_string(yaw++), K::Yaw, {{Mz, -1.0}, {Fy, cx}, {Fx, -cy},
-                       {Fz, -mu * (X + Y)}, {Fx, s1 * Y}, {Mx, -s1 * mu}, {Fz, s1 * mu * cy},
-                       {Fy, s2 * X}, {My, -s2 * mu}, {Fz, -s2 * mu * cx}});
-        }
-      break;
-    }
-  }
-  return out;
-}
 
 ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
                                       const Eigen::Ref<const Eigen::MatrixXd>& J1,
@@ -148,18 +62,24 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
   for (int i = 0; i < nc; ++i) wrenchToWorld(contacts[i].pose, p.balance.middleCols<6>(6 * i));
   p.balanceTarget = balanceWrench;
 
-  const int perContact = contactModelRowCount(settings);
+  const ContactModel& model = *settings.model;
+  const int perContact = model.rowCount();
   p.inequality.setZero(perContact * nc, 6 * nc);
   p.inequalityBound.resize(perContact * nc);
-  for (const ContactSpec& c : contacts) p.contactNames.push_back(c.name);
   for (int i = 0; i < nc; ++i) {
     const ContactSpec& c = contacts[static_cast<std::size_t>(i)];
-    const ContactModelRows rows = contactModelRows(c, settings);
-    p.inequality.block(perContact * i, 6 * i, perContact, 6) = rows.rows;
-    p.inequalityBound.segment(perContact * i, perContact) = rows.bound;
+    const ContactModelRows rows = model.rows(c);
+    const int start = perContact * i;
+    p.contactRowStart.push_back(start);
+    p.contactNames.push_back(c.name);
+    p.inequality.block(start, 6 * i, perContact, 6) = rows.rows;
+    p.inequalityBound.segment(start, perContact) = rows.bound;
     for (const std::string& name : rows.names) p.rowNames.push_back(c.name + "." + name);
-    if (settings.model == ContactModel::Report) p.cones.push_back({6 * i, c.friction});
+    p.rowKinds.insert(p.rowKinds.end(), rows.kinds.begin(), rows.kinds.end());
+    p.contactCone.push_back(model.hasSecondOrderCone() ? static_cast<int>(p.cones.size()) : -1);
+    if (model.hasSecondOrderCone()) p.cones.push_back({6 * i, c.friction, i});
   }
+  p.contactRowStart.push_back(perContact * nc);
   return p;
 }
 
@@ -191,6 +111,10 @@ double ContactProblem::objective(const Eigen::Ref<const Eigen::VectorXd>& F) con
   for (Eigen::Index j = 0; j < F.size(); ++j)
     value += F[j] * (0.5 * hessian.col(j).dot(F) + gradient[j] - 0.5 * tikhonov * F[j]);
   return value;
+}
+
+double ContactProblem::dataScale() const {
+  return 1.0 + hessian.cwiseAbs().maxCoeff() + gradient.cwiseAbs().maxCoeff() + balanceTarget.cwiseAbs().maxCoeff();
 }
 
 double ContactProblem::constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& F) const {

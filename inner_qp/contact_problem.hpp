@@ -10,67 +10,32 @@
 // with the documented Tikhonov term ε (H is singular along wrench directions that move no
 // joint, e.g. every wrench on the reference body).
 //
-// Contact models, all in C_i with fz along the surface normal into the robot:
-//   report       fz ≥ f_min; fx² + fy² ≤ μ² fz² (a second-order cone, kept separate);
-//                centre of pressure in [x_min, x_max] × [y_min, y_max]:
-//                x_min fz ≤ −m_y ≤ x_max fz,  y_min fz ≤ m_x ≤ y_max fz      (2.21, with (2.20) corrected)
-//   pyramid      the cone replaced by k facets inscribed in it: cos θ_i fx + sin θ_i fy ≤ μ cos(π/k) fz
-//   wrench-cone  Caron, Pham, Nakamura (ICRA 2015) for the rectangle, taken about its centre,
-//                with the inscribed friction pyramid μ̃ = μ/√2 (their inner approximation):
-//                |fx|, |fy| ≤ μ̃ fz; centre of pressure as above; and the yaw bounds
-//                −μ̃(X+Y) fz + |Y fx − μ̃ m_x| + |X fy − μ̃ m_y| ≤ m_z ≤ μ̃(X+Y) fz − |Y fx + μ̃ m_x| − |X fy + μ̃ m_y|
-//                (X, Y half-sizes), each absolute value expanded into linear rows. Every
-//                wrench it admits, the report model admits; it forbids the yaw slip besides.
+// Each contact's constraints come from the contact model (inner_qp/contact_model.hpp):
+// report, pyramid or wrench-cone; the problem records which rows and which cone belong to
+// which contact, so that nothing downstream assumes a layout.
 
 #include <Eigen/Core>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/spatial.hpp"
+#include "inner_qp/contact_model.hpp"
 
 namespace mcopt {
 
-enum class ContactModel { Report, Pyramid, WrenchCone };
-
-/// One contact of an inner problem: frame C in the world (z = normal into the robot),
-/// friction μ > 0, rectangle [xMin, xMax] × [yMin, yMax] in C.
-struct ContactSpec {
-  std::string name;
-  RigidTransform pose;
-  double friction = 0.7;
-  double xMin = 0, xMax = 0, yMin = 0, yMax = 0;
-  double minNormalForce = 0.0;  ///< f_min ≥ 0
-};
-
 struct ContactProblemSettings {
-  ContactModel model = ContactModel::Report;
-  int pyramidFacets = 8;    ///< k ≥ 3
+  std::shared_ptr<const ContactModel> model = makeReportContactModel();
   double tikhonov = 1e-9;   ///< ε added to H's diagonal; not part of the reported objective
 };
 
-/// A second-order cone ‖(F[index], F[index + 1])‖ ≤ μ F[index + 2] (report model).
+/// A second-order cone ‖(F[index], F[index + 1])‖ ≤ μ F[index + 2] (a model with
+/// hasSecondOrderCone(), e.g. the report's).
 struct FrictionCone {
   int index = 0;
   double friction = 0.0;
+  int contact = 0;  ///< the contact it belongs to
 };
-
-/// What a contact-model row bounds (results group violations by it).
-enum class ContactRowKind { NormalForce, CenterOfPressure, Friction, Yaw };
-
-/// One contact's linear rows in its own frame, rows · F ≤ bound with F = (f, m) in C: the
-/// model's rows of assembleContactProblem (the report model's friction cone, a second-order
-/// cone, is not among them). The single-level outer formulations hold the same rows on
-/// their wrench variables (outer_nlp/contact_admissibility.hpp).
-struct ContactModelRows {
-  Eigen::Matrix<double, Eigen::Dynamic, 6> rows;
-  Eigen::VectorXd bound;
-  std::vector<std::string> names;     ///< fz_min, cop_x_max, …, facet_<k> or fx_max, …, yaw_min_3
-  std::vector<ContactRowKind> kinds;
-};
-/// Rows a contact has under the model: 5 (report), 5 + facets (pyramid), 17 (wrench cone).
-int contactModelRowCount(const ContactProblemSettings& settings);
-/// Throws InputError for fewer than 3 pyramid facets.
-ContactModelRows contactModelRows(const ContactSpec& contact, const ContactProblemSettings& settings);
 
 /// Problem data, sized once per contact set and overwritten per sample.
 struct ContactProblem {
@@ -83,15 +48,23 @@ struct ContactProblem {
   Vector6 balanceTarget = Vector6::Zero();           ///< W: world axes, about the world origin
   Eigen::MatrixXd inequality;                        ///< G, rows × 6nc: G Fc ≤ bound
   Eigen::VectorXd inequalityBound;
-  std::vector<FrictionCone> cones;                   ///< report model only
+  std::vector<FrictionCone> cones;                   ///< models with hasSecondOrderCone()
   /// Name of each linear row, "<contact>.<row>": fz_min, cop_x_max, cop_x_min, cop_y_max,
   /// cop_y_min, then facet_<k> (pyramid) or fx_max, fx_min, fy_max, fy_min, yaw_<k> (wrench cone).
   std::vector<std::string> rowNames;
+  std::vector<ContactRowKind> rowKinds;              ///< what each linear row bounds
   std::vector<std::string> contactNames;
+  /// Contact i's linear rows are [contactRowStart[i], contactRowStart[i + 1]); its first is
+  /// its normal force's fz ≥ f_min. contactCount + 1 values.
+  std::vector<int> contactRowStart;
+  std::vector<int> contactCone;                      ///< contact i's cone in `cones`, or -1
   Eigen::MatrixXd weightedWrenchToTorque;            ///< scratch of updateObjective, n × 6nc
 
   /// Σ w Γ² + l Γ at Fc, without the Tikhonov term (what results report).
   double objective(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
+  int normalForceRow(int contact) const { return contactRowStart[static_cast<std::size_t>(contact)]; }
+  /// Scale of the data for relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.
+  double dataScale() const;
   /// Largest violation of the balance, the linear rows and the cones (0 when feasible).
   double constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
 };

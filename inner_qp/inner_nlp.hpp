@@ -148,7 +148,4 @@ using NlpRunner = std::function<RunOutcome(const ContactProblem& problem, Balanc
 void solveWithElasticFallback(const ContactProblem& problem, const InnerSettings& settings, const NlpRunner& solverRun,
                               InnerResult& result);
 
-/// Scale of the data for relative tolerances: 1 + ‖H‖∞ + ‖c‖∞ + ‖W‖∞.
-double dataScale(const ContactProblem& problem);
-
 }  // namespace mcopt::inner_detail

@@ -47,13 +47,7 @@ bool isInnerSolverName(const std::string& name) {
   return std::find(names.begin(), names.end(), name) != names.end();
 }
 
-std::string innerSolverList() {
-  const auto& names = innerSolverNames();
-  std::string out;
-  for (std::size_t i = 0; i < names.size(); ++i)
-    out += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
-  return out;
-}
+std::string innerSolverList() { return alternatives(innerSolverNames()); }
 
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings) {
   for (const InnerSolverEntry& e : innerSolvers())
@@ -62,11 +56,6 @@ std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const Inne
 }
 
 namespace inner_detail {
-
-double dataScale(const ContactProblem& p) {
-  return 1.0 + p.hessian.cwiseAbs().maxCoeff() + p.gradient.cwiseAbs().maxCoeff() +
-         p.balanceTarget.cwiseAbs().maxCoeff();
-}
 
 namespace {
 
@@ -91,7 +80,7 @@ void finishResult(const ContactProblem& p, const double* x, InnerResult& r) {
   const int n = 6 * p.contactCount;
   r.wrenches = Eigen::Map<const Eigen::VectorXd>(x, n);
   r.objective = p.objective(r.wrenches);
-  const double scale = dataScale(p);
+  const double scale = p.dataScale();
   const double activeTolerance = 1e-7 * scale;
   r.activeSet.clear();
   const Eigen::Index rows = p.inequality.rows();
@@ -115,7 +104,7 @@ void estimateMultipliers(const ContactProblem& p, InnerResult& r) {
   // checked by the KKT residual, not assumed).
   const int n = 6 * p.contactCount;
   const Eigen::Index rows = p.inequality.rows();
-  const double apex = 1e-7 * dataScale(p);
+  const double apex = 1e-7 * p.dataScale();
   std::vector<std::pair<int, int>> columns;  // (active-set entry, component: -1 surface, 0..2 apex axis)
   for (std::size_t a = 0; a < r.activeSet.size(); ++a) {
     const int row = r.activeSet[a];
@@ -239,7 +228,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
   };
   const auto start = std::chrono::steady_clock::now();
   const int n = 6 * p.contactCount;
-  const double scale = dataScale(p);
+  const double scale = p.dataScale();
   Eigen::VectorXd x(n);
   if (r.wrenches.size() == n && r.wrenches.allFinite())
     x = r.wrenches;  // warm start
@@ -348,7 +337,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
 }  // namespace inner_detail
 
 double kktResidual(const ContactProblem& p, const InnerResult& r) {
-  const double scale = inner_detail::dataScale(p);
+  const double scale = p.dataScale();
   const Eigen::VectorXd& F = r.wrenches;
   double residual = 0.0;
   for (Eigen::Index j = 0; j < F.size(); ++j) residual = std::max(residual, std::abs(inner_detail::stationarity(p, r, j)));

@@ -149,7 +149,7 @@ RunOutcome runIpopt(Ipopt::IpoptApplication* app, const ContactProblem& problem,
   // form on 4. δ = 1e-8 of the data's scale (its curvature 1/δ at the apex is what slows an
   // interior point; 1e-10 reached the optimum on 969 of 1002 problems, 1e-8 on 976, 1e-6 on
   // 959 as the optimum itself moves; tests/inner_qp/test_inner_solvers.cpp).
-  const double smoothing = 1e-8 * inner_detail::dataScale(problem);
+  const double smoothing = 1e-8 * problem.dataScale();
   const InnerNlp nlp(problem, balance, smoothing, band);
   RunOutcome outcome;
   outcome.coneSmoothing = smoothing;

@@ -22,7 +22,7 @@ class NloptProblem {
  public:
   /// Sets `opt`'s objective and constraints from `nlp` (both must outlive the optimisation).
   NloptProblem(nlopt_opt opt, const InnerNlp& nlp, const InnerSettings& settings) : nlp_(nlp) {
-    const double scale = inner_detail::dataScale(nlp.problem());
+    const double scale = nlp.problem().dataScale();
     equalityTolerance_.assign(6, 1e-3 * settings.tolerance * scale);
     inequalityTolerance_.assign(static_cast<std::size_t>(nlp.inequalityCount()), 1e-3 * settings.tolerance * scale);
     nlopt_set_min_objective(opt, objective, this);
@@ -68,11 +68,11 @@ RunOutcome runSlsqp(const ContactProblem& problem, BalanceMode balance, double b
                     Eigen::VectorXd& x) {
   // The smooth inner cone keeps SLSQP's subproblems regular at unloaded contacts; δ is far
   // below every tolerance of the result (1e-10 of the data's scale).
-  const InnerNlp nlp(problem, balance, 1e-10 * inner_detail::dataScale(problem), band);
+  const InnerNlp nlp(problem, balance, 1e-10 * problem.dataScale(), band);
   const auto n = static_cast<unsigned>(nlp.variableCount());
   nlopt_opt opt = nlopt_create(NLOPT_LD_SLSQP, n);
   const NloptProblem bound(opt, nlp, settings);
-  const double scale = inner_detail::dataScale(nlp.problem());
+  const double scale = nlp.problem().dataScale();
   nlopt_set_xtol_rel(opt, 1e-14);
   nlopt_set_ftol_rel(opt, 1e-16);
   nlopt_set_maxeval(opt, settings.maxIterations);

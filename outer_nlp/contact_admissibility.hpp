@@ -6,18 +6,16 @@
 // each environment contact's own wrench there. W_C = (f, m) is the wrench at the contact
 // frame C's origin in C's axes; C is fixed to the wrench's frame, so W_C = A W with A constant.
 //
-// The rows are the scenario's contact model (`inner.contact_model`), the same as the inner
-// problem's (inner_qp/contact_problem.hpp):
-//   report       six smooth rows (report (2.18)–(2.20), the slip of (2.20) corrected):
-//                  f_z                               unilaterality (its lower bound is f_min)
-//                  (μ² f_z² − f_x² − f_y²) / (m g)²  friction cone, scaled to the robot's weight
-//                  −m_y − x_min f_z,  x_max f_z + m_y centre of pressure x = −m_y / f_z
-//                  m_x − y_min f_z,   y_max f_z − m_x centre of pressure y =  m_x / f_z
-//                the inner problem keeps the cone as a second-order cone; here it is one
-//                smooth row.
-//   pyramid,     the inner problem's linear rows G W_C ≤ b (contactModelRows) as b − G W_C ≥ 0,
-//   wrench-cone  in N and N m: f_z first, the four centre-of-pressure rows, then the friction
-//                facets, or |f_x|, |f_y| ≤ μ̃ f_z and the eight yaw-moment rows.
+// The rows are the scenario's contact model's (`inner.contact_model`,
+// ContactModel::admissibilityRows, inner_qp/contact_model.hpp): affine in W_C, with at most
+// one quadratic row, f_z first.
+//   report       six smooth rows (report (2.18)–(2.20), the slip of (2.20) corrected): f_z;
+//                (μ² f_z² − f_x² − f_y²) / (m g)², the friction cone scaled to the robot's
+//                weight (the inner problem keeps it as a second-order cone); the four
+//                centre-of-pressure rows.
+//   pyramid,     the inner problem's linear rows G W_C ≤ b as b − G W_C ≥ 0, in N and N m:
+//   wrench-cone  f_z first, the four centre-of-pressure rows, then the friction facets, or
+//                |f_x|, |f_y| ≤ μ̃ f_z and the eight yaw-moment rows.
 
 #include <Eigen/Core>
 #include <string>
@@ -47,10 +45,10 @@ class ContactAdmissibilityRows {
 
   /// Whether a row is quadratic in W (the report model's friction cone); the others are linear.
   /// The exact Hessian's stencils take the degree from it (motion_hessian.cpp).
-  bool hasQuadraticRows() const { return smoothCone_; }
-  /// The quadratic row's index (the report model's friction cone) and its constant second
-  /// derivative in W (6 × 6); -1 and zero for the linear models.
-  int quadraticRow() const { return smoothCone_ ? 1 : -1; }
+  bool hasQuadraticRows() const { return quadraticRow_ >= 0; }
+  /// The quadratic row's index and its constant second derivative in W (6 × 6); -1 and zero
+  /// for a model without one.
+  int quadraticRow() const { return quadraticRow_; }
   Eigen::Matrix<double, 6, 6> quadraticRowCurvature() const;
   /// W: world axes, about the world origin (or C's own wrench with the identity pose).
   /// rows: rowCount() values; allocation-free.
@@ -64,11 +62,11 @@ class ContactAdmissibilityRows {
 
  private:
   ContactSurface surface_;
-  bool smoothCone_ = true;  ///< the report model's six rows; otherwise linear rows
   Eigen::Matrix<double, 6, 6> toContact_;
-  double scale_;
-  ContactRowsByWrench linearByWrench_;  ///< −G A (linear models)
-  Eigen::VectorXd linearOffset_;        ///< b
+  ContactRowsByWrench linearByWrench_;  ///< L A: the affine part's ∂/∂W
+  Eigen::VectorXd offset_;
+  int quadraticRow_ = -1;
+  Eigen::Matrix<double, 6, 6> quadratic_;  ///< Q in C: the row's ½ W_Cᵀ Q W_C
   std::vector<std::string> names_;
   std::vector<ContactRowKind> kinds_;
 };

@@ -318,18 +318,22 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
                        "' (expected " + innerSolverList() + ")");
     s.inner.solverName = name;
   }
+  std::string modelName = s.inner.problem.model->name();
   if (node["contact_model"]) {
-    const std::string name = yaml::text(file, node["contact_model"], "inner.contact_model");
-    static const std::map<std::string, ContactModel> models = {
-        {"report", ContactModel::Report}, {"pyramid", ContactModel::Pyramid}, {"wrench-cone", ContactModel::WrenchCone}};
-    const auto m = models.find(name);
-    if (m == models.end())
-      throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" + name +
-                       "' (expected report, pyramid or wrench-cone)");
-    s.inner.problem.model = m->second;
+    modelName = yaml::text(file, node["contact_model"], "inner.contact_model");
+    const auto& names = contactModelNames();
+    if (std::find(names.begin(), names.end(), modelName) == names.end())
+      throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" +
+                       modelName + "' (expected " + contactModelList() + ")");
   }
-  if (node["pyramid_facets"])
-    s.inner.problem.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
+  ContactModelOptions options;
+  if (node["pyramid_facets"]) {
+    if (modelName != "pyramid")
+      throw InputError(where(file, node["pyramid_facets"], "inner.pyramid_facets") +
+                       "only the pyramid contact model has facets (the contact model is " + modelName + ")");
+    options.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
+  }
+  s.inner.problem.model = makeContactModel(modelName, options);
   if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
   if (node["polish"]) s.inner.solver.polish = flag(file, node["polish"], "inner.polish");
   if (node["kkt_backend"]) {

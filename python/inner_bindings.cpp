@@ -27,10 +27,9 @@ struct InnerProblemHandle {
   std::string modelName;
   ContactProblem problem;
 
-  InnerProblemHandle(cli::InnerProblemData d, const std::string& contactModel, int facets, double tikhonov)
+  InnerProblemHandle(cli::InnerProblemData d, const std::string& contactModel, std::optional<int> facets, double tikhonov)
       : data(std::move(d)), modelName(contactModel) {
-    settings.model = cli::parseContactModel(contactModel);
-    settings.pyramidFacets = facets;
+    settings.model = cli::parseContactModel(contactModel, facets);
     settings.tikhonov = tikhonov;
     problem = assembleContactProblem(data.contacts, data.wrenchToTorque, data.tau0, data.balance, data.weights,
                                      data.linear, settings);
@@ -99,12 +98,13 @@ void bindInner(py::module_& m) {
   py::class_<InnerProblemHandle, std::shared_ptr<InnerProblemHandle>>(m, "InnerProblem", R"doc(
 One sample's inner problem (formulation.md §7): the contact wrenches F_i (in each contact's
 frame) that minimise Σ w Γ² + l Γ with Γ = tau0 − wrench_to_torque · F, subject to the balance
-B F = W and each contact's model (report, pyramid or wrench-cone). Built from arrays (the
+B F = W and each contact's model (report, pyramid or wrench-cone; `pyramid_facets`, default 8,
+only with the pyramid). Built from arrays (the
 fields of a `mcopt inner` problem, docs/theory/inner-problem.md) or from a robot state and contact
 surfaces (InnerProblem.from_state).)doc")
       .def(py::init([](const py::object& contacts, const py::object& wrenchToTorque, const py::object& tau0,
                        const py::object& balance, const py::object& weights, const py::object& linear,
-                       const std::string& contactModel, int facets, double tikhonov) {
+                       const std::string& contactModel, std::optional<int> facets, double tikhonov) {
              Json node = {{"contacts", jsonOf(contacts, "contacts")},
                           {"wrench_to_torque", jsonOf(wrenchToTorque, "wrench_to_torque")},
                           {"tau0", jsonOf(tau0, "tau0")},
@@ -120,7 +120,7 @@ surfaces (InnerProblem.from_state).)doc")
            }),
            py::arg("contacts"), py::arg("wrench_to_torque"), py::arg("tau0"), py::arg("balance_wrench"),
            py::arg("torque_weights"), py::arg("torque_linear"), py::arg("contact_model") = "report",
-           py::arg("pyramid_facets") = 8, py::arg("tikhonov") = 1e-9,
+           py::arg("pyramid_facets") = py::none(), py::arg("tikhonov") = 1e-9,
            R"doc(`contacts`: a list of dicts {name, position (3), quaternion_xyzw (4), mu,
 rectangle [x_min, x_max, y_min, y_max], min_normal_force}; `wrench_to_torque`: (n, 6 nc);
 `tau0`, `torque_weights`, `torque_linear`: (n,); `balance_wrench`: (6,), world axes about the
@@ -129,7 +129,7 @@ world origin. Sizes, values and keys are checked as `mcopt inner` checks a probl
           "from_state",
           [](const std::shared_ptr<DynamicsHandle>& dynamics, const py::object& q, const py::object& v,
              const py::object& a, const std::vector<std::string>& contacts, const std::string& contactModel,
-             int facets, double tikhonov) {
+             std::optional<int> facets, double tikhonov) {
             DynamicsHandle& d = *dynamics;
             const int n = d.model.jointCount();
             const Eigen::VectorXd qs = vectorArgument(q, "q", n);
@@ -141,8 +141,8 @@ world origin. Sizes, values and keys are checked as `mcopt inner` checks a probl
             // The bilevel formulation's own sample assembly (formulation.md §5, §7).
             inverseDynamics(d.model, d.data, qs, vs, as);
             ContactProblemSettings settings;
-            settings.model = cli::parseContactModel(contactModel);
-            settings.pyramidFacets = facets, settings.tikhonov = tikhonov;
+            settings.model = cli::parseContactModel(contactModel, facets);
+            settings.tikhonov = tikhonov;
             SampleProblem sample(d.model, surfaces, settings);
             sample.update(d.model, d.data, d.robot->actuators, surfaces, vs, as);
             cli::InnerProblemData data;
@@ -158,7 +158,7 @@ world origin. Sizes, values and keys are checked as `mcopt inner` checks a probl
             return std::make_shared<InnerProblemHandle>(std::move(data), contactModel, facets, tikhonov);
           },
           py::arg("dynamics"), py::arg("q"), py::arg("v") = py::none(), py::arg("a") = py::none(),
-          py::arg("contacts"), py::arg("contact_model") = "report", py::arg("pyramid_facets") = 8,
+          py::arg("contacts"), py::arg("contact_model") = "report", py::arg("pyramid_facets") = py::none(),
           py::arg("tikhonov") = 1e-9,
           R"doc(The inner problem at state (q, v, a) with the named contact surfaces of the
 dynamics' robot, as the bilevel formulation builds it at a sample: Γ0 and W0 from Newton–Euler,

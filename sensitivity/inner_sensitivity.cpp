@@ -224,20 +224,22 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
   m.diagnostics = {};
   m.weightedWrenchToTorque = p.weightedWrenchToTorque;
   const Eigen::VectorXd& F = r.wrenches;
-  const double scale = 1.0 + p.hessian.cwiseAbs().maxCoeff() + p.gradient.cwiseAbs().maxCoeff() +
-                       p.balanceTarget.cwiseAbs().maxCoeff();
+  const double scale = p.dataScale();
   const double strict = m.settings.strictMultiplier * scale;
   const double forceScale = 1.0 + F.cwiseAbs().maxCoeff();
   const auto rowCount = static_cast<int>(p.inequality.rows());
   const auto coneCount = static_cast<int>(p.cones.size());
-  const int perContact = rowCount / nc;  // assembly order: each contact's rows together, fz_min first
   m.active.assign(static_cast<std::size_t>(rowCount + coneCount), 0);
   for (int a : r.activeSet) m.active[static_cast<std::size_t>(a)] = 1;
 
-  // Assembled in a buffer of the largest size (one slot per linear row and cone; an unloaded
-  // contact's pins, ≤ 6, take the slots of its own rows and cone, ≥ 6 in every contact model),
-  // the used rows first; the used block is then factorised.
-  const int size = n + 6 + rowCount + coneCount;
+  // Assembled in a buffer of the largest size (per contact, one slot per linear row and cone,
+  // or its pins when unloaded, at most 6), the used rows first; the used block is then factorised.
+  int size = n + 6;
+  for (int i = 0; i < nc; ++i) {
+    const int own = p.contactRowStart[static_cast<std::size_t>(i) + 1] - p.contactRowStart[static_cast<std::size_t>(i)] +
+                    (p.contactCone[static_cast<std::size_t>(i)] >= 0 ? 1 : 0);
+    size += std::max(own, 6);
+  }
   m.kkt.setZero(size, size);
   m.lagrangianHessian = p.hessian;
   m.kkt.block(n, 0, 6, n) = p.balance;
@@ -254,9 +256,11 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     ++next;
   };
   for (int i = 0; i < nc; ++i) {
-    const int fzRow = perContact * i;
+    // The contact's rows and cone, as its model laid them out (contact_problem.hpp).
+    const int fzRow = p.normalForceRow(i);
+    const int rowEnd = p.contactRowStart[static_cast<std::size_t>(i) + 1];
     const double fz = F[6 * i + 2];
-    const int cone = p.cones.empty() ? -1 : i;  // report model: cone i belongs to contact i
+    const int cone = p.contactCone[static_cast<std::size_t>(i)];
     // Held at zero by its fz_min row or by its cone's apex (the active-set method certifies
     // an unloaded contact through the cone's planes, whose multipliers make y_z).
     const bool apex = cone >= 0 && m.active[static_cast<std::size_t>(rowCount + cone)];
@@ -272,11 +276,11 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       if (cone >= 0) push += r.coneMultipliers[3 * cone + 2];
       if (!(push > strict)) ++m.diagnostics.weaklyActive;
       bool yawHeld = false;
-      for (int k = fzRow; k < fzRow + perContact; ++k) yawHeld |= p.inequality(k, 6 * i + 5) != 0.0;
+      for (int k = fzRow; k < rowEnd; ++k) yawHeld |= p.rowKinds[static_cast<std::size_t>(k)] == ContactRowKind::Yaw;
       for (int component = 0; component < (yawHeld ? 6 : 5); ++component) addUnit(6 * i + component);
       continue;
     }
-    for (int k = fzRow; k < fzRow + perContact; ++k) {
+    for (int k = fzRow; k < rowEnd; ++k) {
       if (!m.active[static_cast<std::size_t>(k)]) continue;
       if (r.inequalityMultipliers[k] > strict) {
         addRow(p.inequality.row(k));

@@ -12,7 +12,7 @@
 //
 // Unloaded contacts (formulation.md §7): a contact whose fz sits at zero with a positive
 // multiplier stays unloaded under small perturbations, and its centre-of-pressure rows then
-// pin m_x = m_y = 0 (its yaw rows, in the wrench-cone model, m_z = 0): its wrench components
+// pin m_x = m_y = 0 (its yaw rows, as the wrench-cone model has, m_z = 0): its wrench components
 // are held by unit rows and its own rows and cone leave the system.
 //
 // Degenerate points — an active constraint with (near) zero multiplier, or a near-singular

@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
 
   // One inner problem at the motion's middle sample: the wrenches of both soles.
   ContactProblemSettings settings;
-  settings.model = ContactModel::WrenchCone;
+  settings.model = makeContactModel("wrench-cone");
   SampleProblem sample(model, soles, settings);
   DynamicsData data(model);
   const int middle = 15;

@@ -69,7 +69,7 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
     for (std::size_t k = 0; k < problems.size(); ++k) {
       const Json& result = results[k];
       INFO("problem " << k);
-      const ContactProblem p = test::assemble(problems[k], ContactModel::Report);
+      const ContactProblem p = test::assemble(problems[k], "report");
       InnerResult expected;
       makeInnerSolver(solver)->solve(p, expected);
       CHECK(result["status"] == toString(expected.status));
@@ -141,6 +141,8 @@ TEST_CASE("inner: bad input names the file and field", "[cli][inner][input]") {
   expectError(bad, "", {"problems[0]", "missing 'balance_wrench'"});
   expectError(good, " --solver qpoases", {"solver", "expected " + innerSolverList(), "'qpoases'"});
   expectError(good, " --contact-model soft", {"--contact-model", "report, pyramid or wrench-cone"});
+  expectError(good, " --pyramid-facets 6", {"pyramid facets", "only the pyramid contact model has facets"});
+  expectError(good, " --contact-model pyramid --pyramid-facets 2", {"pyramid facets", "at least 3"});
   const auto r = test::runMcopt("inner --problems " + test::quoted(dir.path() / "missing.json"));
   CHECK(r.exitCode == 2);
   CHECK_THAT(r.errors, Contains("missing.json") && Contains("cannot open"));

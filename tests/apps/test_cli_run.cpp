@@ -676,7 +676,13 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"unknown formulation", [](YAML::Node& r) { r["contact_forces"] = "penalty"; },
        {"contact_forces: unknown contact-force formulation 'penalty' (expected bilevel, splines or variables)"}},
       {"unknown contact model", [](YAML::Node& r) { r["inner"]["contact_model"] = "cone"; },
-       {"inner.contact_model: unknown contact model 'cone'"}},
+       {"inner.contact_model: unknown contact model 'cone'", "(expected report, pyramid or wrench-cone)"}},
+      {"facets without the pyramid", [](YAML::Node& r) { r["inner"]["pyramid_facets"] = 6; },
+       {"inner.pyramid_facets: only the pyramid contact model has facets"}},
+      {"too few facets", [](YAML::Node& r) {
+         r["inner"]["contact_model"] = "pyramid";
+         r["inner"]["pyramid_facets"] = 2;
+       }, {"inner.pyramid_facets"}},
       {"unknown inner solver", [](YAML::Node& r) { r["inner"]["solver"] = "qpoases"; },
        {"inner.solver: unknown inner solver 'qpoases'"}},
       {"inner polishing not a flag", [](YAML::Node& r) { r["inner"]["polish"] = "sometimes"; },

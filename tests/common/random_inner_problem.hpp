@@ -60,10 +60,10 @@ inline RandomProblem randomProblem(std::mt19937& rng, int nc, int joints = 12) {
   return r;
 }
 
-inline ContactProblem assemble(const RandomProblem& r, ContactModel model, int facets = 8) {
+/// The problem under a registered contact model ("report", "pyramid", "wrench-cone").
+inline ContactProblem assemble(const RandomProblem& r, const std::string& model, int facets = 8) {
   ContactProblemSettings settings;
-  settings.model = model;
-  settings.pyramidFacets = facets;
+  settings.model = makeContactModel(model, {.pyramidFacets = facets});
   return assembleContactProblem(r.contacts, r.wrenchToTorque, r.tau0, r.balance, r.weights, r.linear, settings);
 }
 

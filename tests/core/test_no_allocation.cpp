@@ -157,7 +157,7 @@ TEST_CASE("a one-contact motion's evaluation and exact gradient allocate nothing
 namespace {
 
 struct ContactCase {
-  ContactModel model;
+  std::string model;
   int contacts;  ///< the first 2, 3 or 4 surfaces: soles, then hands
   bool warm;     ///< the active-set method warm-started from the previous sample
 };
@@ -165,14 +165,10 @@ struct ContactCase {
 /// 2–4 contacts × each model × warm and cold (formulation.md §7).
 std::vector<ContactCase> contactCases() {
   std::vector<ContactCase> cases;
-  for (const ContactModel model : {ContactModel::Report, ContactModel::Pyramid, ContactModel::WrenchCone})
+  for (const std::string& model : contactModelNames())
     for (const int contacts : {2, 3, 4})
       for (const bool warm : {true, false}) cases.push_back({model, contacts, warm});
   return cases;
-}
-
-const char* modelName(ContactModel m) {
-  return m == ContactModel::Report ? "report" : m == ContactModel::Pyramid ? "pyramid" : "wrench-cone";
 }
 
 struct HalfSitting {
@@ -190,7 +186,7 @@ struct HalfSitting {
   }
   MultiContactSettings settings(const ContactCase& c) const {
     MultiContactSettings s;
-    s.problem.model = c.model;
+    s.problem.model = makeContactModel(c.model);
     s.solver.warmStart = c.warm;
     return s;
   }
@@ -212,7 +208,7 @@ TEST_CASE("a multi-contact motion (inverse dynamics → inner active-set solve p
     Measured measured;
     evaluator.evaluate(x, 1.5, result);
     const long during = measured.count();  // read before INFO, which allocates its message
-    INFO(modelName(c.model) << ", " << c.contacts << " contacts, " << (c.warm ? "warm" : "cold"));
+    INFO(c.model << ", " << c.contacts << " contacts, " << (c.warm ? "warm" : "cold"));
     CHECK(during == 0);
     CHECK(result.failedSamples == 0);
   }
@@ -233,7 +229,7 @@ TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) alloca
     Measured measured;
     evaluator.evaluate(x, 1.5, result, gradient);
     const long during = measured.count();
-    INFO(modelName(c.model) << ", " << c.contacts << " contacts, " << (c.warm ? "warm" : "cold"));
+    INFO(c.model << ", " << c.contacts << " contacts, " << (c.warm ? "warm" : "cold"));
     CHECK(during == 0);
     CHECK(gradient.samplesWithoutDerivative == 0);
   }
@@ -277,7 +273,7 @@ TEST_CASE("the sensitivity of degenerate samples allocates nothing once warm: we
   for (int trial = 0; trial < 40 && (weak < 3 || singular < 3); ++trial) {
     // 6 joints for 24 wrench components: H's rank is at most 6.
     const test::RandomProblem r = test::randomProblem(rng, 4, 6);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solved;
     activeSet->solve(p, solved);
     if (solved.status != InnerStatus::Optimal) continue;

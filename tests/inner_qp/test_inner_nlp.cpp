@@ -20,9 +20,9 @@ TEST_CASE("InnerNlp: every constraint value is written and matches its Jacobian,
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const Eigen::VectorXd F = Eigen::VectorXd::NullaryExpr(12, [&] { return 100.0 * u(rng); });
   const double band = 0.25;
-  for (const ContactModel model : {ContactModel::Report, ContactModel::Pyramid, ContactModel::WrenchCone})
+  for (const std::string& model : contactModelNames())
   for (const BalanceMode mode : {BalanceMode::Equality, BalanceMode::Dropped, BalanceMode::Band}) {
-    INFO("contact model " << static_cast<int>(model) << ", balance mode " << static_cast<int>(mode));
+    INFO("contact model " << model << ", balance mode " << static_cast<int>(mode));
     const ContactProblem problem = test::assemble(random, model);
     const InnerNlp nlp(problem, mode, 1e-3, band);
     const int n = nlp.variableCount(), mi = nlp.inequalityCount(), me = nlp.equalityCount();

@@ -109,7 +109,7 @@ TEST_CASE("the three solvers reach the same optimum of the report model", "[inne
   for (int nc : {2, 3, 4}) {
     for (int trial = 0; trial < kPerContactCount; ++trial, ++problems) {
       const RandomProblem r = randomProblem(rng, nc);
-      const ContactProblem p = assemble(r, ContactModel::Report);
+      const ContactProblem p = assemble(r, "report");
       InnerResult reference;
       activeSet->solve(p, reference);
       INFO(nc << " contacts, trial " << trial << ": active-set " << toString(reference.status) << " ("
@@ -161,7 +161,7 @@ TEST_CASE("with a positive definite objective the solvers agree on wrenches and 
   int compared = 0;
   for (int trial = 0; trial < 40; ++trial) {
     const RandomProblem r = randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = assemble(r, ContactModel::Report);
+    const ContactProblem p = assemble(r, "report");
     InnerResult a, b;
     activeSet->solve(p, a);
     ipopt->solve(p, b);
@@ -190,10 +190,10 @@ TEST_CASE("many-facet pyramids converge to the report optimum from above", "[inn
   for (int trial = 0; trial < 20; ++trial) {
     const RandomProblem r = randomProblem(rng, 2 + trial % 3);
     InnerResult cone;
-    activeSet->solve(assemble(r, ContactModel::Report), cone);
+    activeSet->solve(assemble(r, "report"), cone);
     REQUIRE(cone.status == InnerStatus::Optimal);
     for (std::size_t f = 0; f < facetCounts.size(); ++f) {
-      const ContactProblem pyramid = assemble(r, ContactModel::Pyramid, facetCounts[f]);
+      const ContactProblem pyramid = assemble(r, "pyramid", facetCounts[f]);
       InnerResult result;
       activeSet->solve(pyramid, result);
       INFO("trial " << trial << ", " << facetCounts[f] << " facets: " << toString(result.status) << " " << result.message);
@@ -232,8 +232,8 @@ TEST_CASE("the wrench cone's optimum is admissible for the report model, yaw bou
   for (int trial = 0; trial < 60; ++trial) {
     RandomProblem r = randomProblem(rng, 2 + trial % 3);
     r.tau0 *= 3.0;  // strong torques: the power-optimal wrenches lean on the yaw moment too
-    const ContactProblem report = assemble(r, ContactModel::Report);
-    const ContactProblem wrenchCone = assemble(r, ContactModel::WrenchCone);
+    const ContactProblem report = assemble(r, "report");
+    const ContactProblem wrenchCone = assemble(r, "wrench-cone");
     InnerResult a, b;
     activeSet->solve(report, a);
     activeSet->solve(wrenchCone, b);
@@ -285,7 +285,7 @@ TEST_CASE("infeasible problems: the active-set method proves it and finds the le
       RandomProblem r = randomProblem(rng, 2);
       for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};  // both on the floor, at the origin
       r.balance = demand;
-      const ContactProblem p = assemble(r, ContactModel::Report);
+      const ContactProblem p = assemble(r, "report");
       InnerResult least;
       activeSet->solve(p, least);
       INFO(what << ", trial " << trial << ", active-set: " << least.message << "; slack " << least.balanceSlack.transpose());
@@ -342,7 +342,7 @@ TEST_CASE("warm starts along a smooth motion cut the active-set iterations, not 
     r.wrenchToTorque = (1 - s) * a.wrenchToTorque + s * b.wrenchToTorque;
     r.tau0 = (1 - s) * a.tau0 + s * b.tau0;
     r.balance = (1 - s) * a.balance + s * b.balance;
-    const ContactProblem p = assemble(r, ContactModel::Report);
+    const ContactProblem p = assemble(r, "report");
     warm->solve(p, warmResult);  // the previous sample's result is the warm start
     cold->solve(p, coldResult);
     REQUIRE(warmResult.status == InnerStatus::Optimal);
@@ -374,7 +374,7 @@ TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-
 #endif
   for (int trial = 0; trial < kTrials; ++trial) {
     const RandomProblem r = randomProblem(rng, 2 + trial % 3);
-    const ContactProblem p = assemble(r, trial % 2 == 0 ? ContactModel::WrenchCone : ContactModel::Pyramid);
+    const ContactProblem p = assemble(r, trial % 2 == 0 ? "wrench-cone" : "pyramid");
     InnerResult reference;
     activeSet->solve(p, reference);
     if (reference.status != InnerStatus::Optimal) continue;
@@ -409,7 +409,7 @@ TEST_CASE("polishing: SLSQP and Ipopt on their own active sets reach the active-
   for (const ContactSpec& c : r.contacts) reach = std::max(reach, -c.xMin);
   const double slackNorm = 0.05;
   r.balance << 0, 0, 300, 0, reach * 300 + slackNorm * std::sqrt(1.0 + reach * reach), 0;
-  const ContactProblem tip = assemble(r, ContactModel::WrenchCone);
+  const ContactProblem tip = assemble(r, "wrench-cone");
   const Vector6 expected = exactLeastSlack("tip", r.balance, r.contacts);
   REQUIRE(expected.norm() == Approx(slackNorm).epsilon(1e-9));
   InnerResult least;

@@ -36,7 +36,7 @@ struct TwoSoles {
   }
   static ContactProblemSettings wrenchCone() {
     ContactProblemSettings settings;
-    settings.model = ContactModel::WrenchCone;
+    settings.model = makeWrenchConeContactModel();
     return settings;
   }
   /// The sample's inner problem at (q, v, a).

@@ -33,10 +33,9 @@ RigidTransform tiltedPose() {
   return pose;
 }
 
-ContactProblemSettings modelSettings(ContactModel model) {
+ContactProblemSettings modelSettings(const std::string& model) {
   ContactProblemSettings s;
-  s.model = model;
-  s.pyramidFacets = 6;
+  s.model = makeContactModel(model, {.pyramidFacets = 6});
   return s;
 }
 
@@ -61,9 +60,9 @@ TEST_CASE("contact admissibility rows: the scenario's contact model, as the inne
   Matrix6 toWorld;
   wrenchToWorld(pose, toWorld);  // the wrench maps' own transform, not the rows'
   std::mt19937 rng(5);
-  for (const ContactModel model : {ContactModel::Report, ContactModel::Pyramid, ContactModel::WrenchCone}) {
+  for (const std::string model : {"report", "pyramid", "wrench-cone"}) {
     const ContactAdmissibilityRows rows(surface, pose, weight, modelSettings(model));
-    const int expected = model == ContactModel::Report ? 6 : model == ContactModel::Pyramid ? 5 + 6 : 17;
+    const int expected = model == "report" ? 6 : model == "pyramid" ? 5 + 6 : 17;
     REQUIRE(rows.rowCount() == expected);
     CHECK(rows.rowKind(0) == ContactRowKind::NormalForce);
     int admitted = 0, refused = 0;
@@ -79,7 +78,7 @@ TEST_CASE("contact admissibility rows: the scenario's contact model, as the inne
       CHECK(values[0] == Approx(contact[2]).epsilon(1e-12));
       const double inner = innerViolation(surface, pose, modelSettings(model), contact, world);
       const double outer = std::max(0.0, -values.minCoeff());
-      if (model == ContactModel::Report) {
+      if (model == "report") {
         // The inner problem keeps the cone as ‖f_xy‖ ≤ μ f_z, the outer row squares it: the
         // same set, other units; decided the same way away from its boundary.
         if (inner > 1e-6 || outer > 1e-9) CHECK((inner > 0.0) == (outer > 0.0));
@@ -105,11 +104,54 @@ TEST_CASE("contact admissibility rows: the scenario's contact model, as the inne
   }
 }
 
+TEST_CASE("contact admissibility rows: a model written outside the registry reaches the outer rows as it is",
+          "[outer][contact]") {
+  // A strip contact (the rectangle's x extent only, the friction pyramid): no bundled layout.
+  class StripContactModel final : public ContactModel {
+   public:
+    std::string name() const override { return "strip"; }
+    int rowCount() const override { return 7; }
+
+   protected:
+    void writeRows(const ContactSpec& c, ContactRowWriter& out) const override {
+      using W = ContactRowWriter;
+      out.add("fz_min", ContactRowKind::NormalForce, {{W::Fz, -1.0}}, -c.minNormalForce);
+      for (const double s : {1.0, -1.0}) {
+        out.add(s > 0 ? "fx_max" : "fx_min", ContactRowKind::Friction, {{W::Fx, s}, {W::Fz, -c.friction}});
+        out.add(s > 0 ? "fy_max" : "fy_min", ContactRowKind::Friction, {{W::Fy, s}, {W::Fz, -c.friction}});
+      }
+      out.add("cop_x_max", ContactRowKind::CenterOfPressure, {{W::My, -1.0}, {W::Fz, -c.xMax}});
+      out.add("cop_x_min", ContactRowKind::CenterOfPressure, {{W::My, 1.0}, {W::Fz, c.xMin}});
+    }
+  };
+  ContactProblemSettings settings;
+  settings.model = std::make_shared<StripContactModel>();
+  const ContactSurface surface = sole();
+  const RigidTransform pose = tiltedPose();
+  const ContactAdmissibilityRows rows(surface, pose, 58.0 * 9.81, settings);
+  REQUIRE(rows.rowCount() == 7);
+  CHECK_FALSE(rows.hasQuadraticRows());
+  CHECK(rows.rowName(4) == "fy_min");
+  CHECK(rows.rowKind(5) == ContactRowKind::CenterOfPressure);
+  Matrix6 toWorld;
+  wrenchToWorld(pose, toWorld);
+  const Vector6 contact = (Vector6() << 30.0, -20.0, 400.0, 3.0, -8.0, 1.0).finished();
+  Eigen::VectorXd values(7);
+  rows.evaluate(toWorld * contact, values);
+  ContactSpec spec;
+  spec.friction = surface.friction, spec.xMin = surface.xMin, spec.xMax = surface.xMax;
+  spec.yMin = surface.yMin, spec.yMax = surface.yMax;
+  const ContactModelRows inner = settings.model->rows(spec);
+  const Eigen::VectorXd expected = inner.bound - inner.rows * contact;  // b − G W_C ≥ 0, f_z first
+  CHECK((values - expected).cwiseAbs().maxCoeff() <= 1e-9 * contact.norm());
+  CHECK(values[0] == Approx(400.0));
+}
+
 TEST_CASE("contact admissibility rows: the wrench cone refuses a yaw slip that the report model admits", "[outer][contact]") {
   const ContactSurface surface = sole();
   const double weight = 58.0 * 9.81;
-  const ContactAdmissibilityRows report(surface, RigidTransform{}, weight, modelSettings(ContactModel::Report));
-  const ContactAdmissibilityRows cone(surface, RigidTransform{}, weight, modelSettings(ContactModel::WrenchCone));
+  const ContactAdmissibilityRows report(surface, RigidTransform{}, weight, modelSettings("report"));
+  const ContactAdmissibilityRows cone(surface, RigidTransform{}, weight, modelSettings("wrench-cone"));
   // Standing on the rectangle's centre, twisted about the normal: the most the wrench cone
   // admits is μ̃ (X + Y) f_z = 0.7/√2 · 0.235 · 500 ≈ 58 N m.
   const double cx = 0.5 * (surface.xMin + surface.xMax), cy = 0.5 * (surface.yMin + surface.yMax);
@@ -135,8 +177,8 @@ TEST_CASE("contact admissibility rows: the wrench cone refuses a yaw slip that t
 TEST_CASE("single-level formulations: every wrench holds the scenario's contact model, yaw rows included",
           "[outer][contact][multi-contact]") {
   for (const ContactForces forces : {ContactForces::Variables, ContactForces::Splines}) {
-    std::map<ContactModel, MotionProblem::Violations> twisted;
-    for (const ContactModel model : {ContactModel::Report, ContactModel::WrenchCone}) {
+    std::map<std::string, MotionProblem::Violations> twisted;
+    for (const std::string model : {"report", "wrench-cone"}) {
       Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
       s.samples = 8, s.outputSamples = 20, s.forceControlPoints = 5;
       s.contactForces = forces;
@@ -149,7 +191,7 @@ TEST_CASE("single-level formulations: every wrench holds the scenario's contact 
           if (yawRows == 1) CHECK(problem.rowName(r).find("yaw_") != std::string::npos);
         }
       // Two contacts (the soles) at every sample, eight yaw rows each.
-      CHECK(yawRows == (model == ContactModel::WrenchCone ? 8 * 2 * s.samples : 0));
+      CHECK(yawRows == (model == "wrench-cone" ? 8 * 2 * s.samples : 0));
       Eigen::VectorXd x = problem.initialPoint(s.start, s.end);
       const MotionProblem::Violations start = problem.violations(x);
       // Twist the right sole about its normal by 150 N m (each component m_z of its wrench
@@ -158,11 +200,11 @@ TEST_CASE("single-level formulations: every wrench holds the scenario's contact 
         x[k] += 150.0;
       twisted[model] = problem.violations(x);
       const auto kind = [](ConstraintKind k) { return static_cast<std::size_t>(k); };
-      INFO(toString(forces) << (model == ContactModel::Report ? ", report" : ", wrench-cone"));
+      INFO(toString(forces) << (model == "report" ? ", report" : ", wrench-cone"));
       CHECK(start.byKind[kind(ConstraintKind::ContactYaw)] < 1e-9);
       for (const ConstraintKind k : {ConstraintKind::ContactUnilateral, ConstraintKind::ContactCop})
         CHECK(twisted[model].byKind[kind(k)] == Approx(start.byKind[kind(k)]).margin(1e-9));
-      if (model == ContactModel::Report) CHECK(twisted[model].byKind[kind(ConstraintKind::ContactYaw)] == 0.0);
+      if (model == "report") CHECK(twisted[model].byKind[kind(ConstraintKind::ContactYaw)] == 0.0);
       else CHECK(twisted[model].byKind[kind(ConstraintKind::ContactYaw)] > 50.0);
     }
   }

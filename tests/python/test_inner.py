@@ -165,6 +165,8 @@ def test_bad_types_and_names_raise(hrp2):
         mcopt.InnerProblem(**{**data, "tau0": [float("nan")] * 30})
     with pytest.raises(mcopt.InputError, match="contact-model"):
         mcopt.InnerProblem(**data, contact_model="cone")
+    with pytest.raises(mcopt.InputError, match="only the pyramid contact model has facets"):
+        mcopt.InnerProblem(**data, pyramid_facets=6)
     with pytest.raises(mcopt.InputError, match="expected active-set, slsqp or ipopt; got 'simplex'"):
         mcopt.InnerSolver("simplex")
     d = mcopt.Dynamics(hrp2, "r_sole")

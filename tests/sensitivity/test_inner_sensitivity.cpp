@@ -21,7 +21,7 @@ Eigen::VectorXd solveMoved(InnerSolver& solver, test::RandomProblem r, int which
     r.tau0[which] += step;
   else
     r.balance[which - r.tau0.size()] += step;
-  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  const ContactProblem p = test::assemble(r, "report");
   InnerResult result;
   solver.solve(p, result);
   REQUIRE(result.status == InnerStatus::Optimal);
@@ -33,7 +33,7 @@ double optimalValue(InnerSolver& solver, test::RandomProblem r, int which, doubl
     r.tau0[which] += step;
   else
     r.balance[which - r.tau0.size()] += step;
-  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  const ContactProblem p = test::assemble(r, "report");
   InnerResult result;
   solver.solve(p, result);
   REQUIRE(result.status == InnerStatus::Optimal);
@@ -52,7 +52,7 @@ TEST_CASE("dF/dτ0 and dF/dW agree with central differences of the re-solved pro
   for (int trial = 0; trial < 24; ++trial) {
     const int nc = 2 + trial % 3;
     const test::RandomProblem r = test::randomProblem(rng, nc, 30);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
@@ -97,7 +97,7 @@ TEST_CASE("envelope theorem: the chain rule through dF/dp equals ∂L/∂p", "[s
   int checked = 0;
   for (int trial = 0; trial < 12; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
@@ -133,7 +133,7 @@ TEST_CASE("dense, KLU and UMFPACK factorisations give the same sensitivities", "
   auto activeSet = makeActiveSetSolver();
   for (int trial = 0; trial < 6; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
@@ -167,7 +167,7 @@ TEST_CASE("sensitivities of a result that is not optimal are refused, by name", 
   test::RandomProblem r = test::randomProblem(rng, 2, 30);
   for (ContactSpec& c : r.contacts) c.pose = RigidTransform{};
   r.balance << 0, 0, -300, 0, 0, 0;  // the floor would have to pull: infeasible
-  const ContactProblem p = test::assemble(r, ContactModel::Report);
+  const ContactProblem p = test::assemble(r, "report");
   InnerResult result;
   makeActiveSetSolver()->solve(p, result);
   REQUIRE(result.status == InnerStatus::Infeasible);
@@ -192,7 +192,7 @@ TEST_CASE("an unloaded contact is held at zero and the derivatives still match d
     r.contacts.push_back(three.contacts[2]);  // the hand on the wall
     r.wrenchToTorque.conservativeResize(Eigen::NoChange, 18);
     r.wrenchToTorque.rightCols(6) = three.wrenchToTorque.rightCols(6);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
@@ -225,7 +225,7 @@ TEST_CASE("sensitivities from each solver's own result agree with the active-set
   int compared[2] = {0, 0};
   for (int trial = 0; trial < 15; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult reference;
     activeSet->solve(p, reference);
     REQUIRE(reference.status == InnerStatus::Optimal);
@@ -270,7 +270,7 @@ TEST_CASE("a weakly active constraint is reported as degenerate and left out", "
   int tested = 0;
   for (int trial = 0; trial < 20 && tested < 3; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 3, 30);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     REQUIRE(solution.status == InnerStatus::Optimal);
@@ -305,7 +305,7 @@ TEST_CASE("the KKT condition estimate bounds the exact one, and a near-singular 
   int bounded = 0, singular = 0;
   for (int trial = 0; trial < 60; ++trial) {
     const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, trial % 2 == 0 ? 12 : 6);
-    const ContactProblem p = test::assemble(r, ContactModel::Report);
+    const ContactProblem p = test::assemble(r, "report");
     InnerResult solution;
     activeSet->solve(p, solution);
     if (solution.status != InnerStatus::Optimal) continue;
