@@ -59,7 +59,7 @@ int runInner(const InnerOptions& o) {
     } catch (const InputError& e) {
       throw InputError(file.string() + ": " + field + ": " + e.what());
     }
-    if (previous.wrenches.size() != 6 * p.contactCount) previous = InnerResult{};
+    if (previous.wrenches.size() != p.variableCount()) previous = InnerResult{};
     solver->solve(p, previous);
     Json result = innerResultToJson(p, previous);
     if (o.sensitivity) addInnerSensitivity(p, previous, sensitivitySettings, result);

@@ -78,7 +78,7 @@ Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
   Json out;
   out["status"] = toString(r.status);
   Json wrenches = Json::array();
-  for (int i = 0; i < p.contactCount; ++i) wrenches.push_back(json_io::toJson(r.wrenches.segment<6>(6 * i)));
+  for (int i = 0; i < p.contactCount; ++i) wrenches.push_back(json_io::toJson(p.contactWrench(r.wrenches, i)));
   out["wrenches"] = wrenches;
   out["objective"] = r.objective;
   Json multipliers;
@@ -124,8 +124,8 @@ void addInnerSensitivity(const ContactProblem& p, const InnerResult& r, const Se
   const SensitivityDiagnostics& d = sensitivity.factorize(p, r);
   Eigen::MatrixXd dTau0, dBalance;
   sensitivity.dataSensitivities(p, dTau0, dBalance);
-  out["dwrenches_dtau0"] = json_io::matrixToJson(dTau0);
-  out["dwrenches_dbalance"] = json_io::matrixToJson(dBalance);
+  out["dwrenches_dtau0"] = json_io::matrixToJson(p.wrenchRows(dTau0));
+  out["dwrenches_dbalance"] = json_io::matrixToJson(p.wrenchRows(dBalance));
   out["sensitivity"] = {{"degenerate", d.degenerate()}, {"diagnostics", d.describe()}};
 }
 

@@ -8,6 +8,7 @@
 
 #include "apps/json_io.hpp"
 #include "core/atomic_file.hpp"
+#include "inner_qp/multi_contact_dynamics.hpp"
 
 namespace mcopt::cli {
 
@@ -134,6 +135,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
     const ContactSurface& surface = c == 0 ? scenario.support : scenario.contacts[c - 1].surface;
     contact["rectangle_m"] = {{"x", {surface.xMin, surface.xMax}}, {"y", {surface.yMin, surface.yMax}}};
     contact["friction"] = surface.friction;
+    contact["contact_model"] = contactModelOf(contactSpec(surface), scenario.inner.problem).name();
     Json active = Json::array(), wrench = Json::array(), copJson = Json::array();
     for (int s = 0; s < N; ++s) {
       const bool on = r.active[c][static_cast<std::size_t>(s)];

@@ -98,7 +98,7 @@ class ActiveSetSolver final : public InnerSolver {
 };
 
 void ActiveSetSolver::resize(const ContactProblem& p) {
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   const int rows = static_cast<int>(p.inequality.rows());
   const int cones = static_cast<int>(p.cones.size());
   if (n == variables_ && rows == rows_ && cones == cones_) return;

@@ -19,7 +19,7 @@ namespace {
 /// Dependent active rows (an unloaded contact at the wrench cone's apex) leave it singular but
 /// consistent; the least-norm solution is one of its solutions. Returns F.
 Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, const std::vector<int>& rows) {
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
   const auto m = static_cast<Eigen::Index>(balanceRows + rows.size());
   Eigen::MatrixXd kkt = Eigen::MatrixXd::Zero(n + m, n + m);
@@ -44,7 +44,7 @@ Eigen::VectorXd solveOnActiveRows(const ContactProblem& p, BalanceMode balance, 
 ContactProblem withBandRows(const ContactProblem& p, double band) {
   ContactProblem banded = p;
   const Eigen::Index rows = p.inequality.rows();
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   banded.inequality.resize(rows + 12, n);
   banded.inequalityBound.resize(rows + 12);
   banded.inequality.topRows(rows) = p.inequality;
@@ -72,7 +72,7 @@ ContactProblem withBandRows(const ContactProblem& p, double band) {
 /// "Polishing").
 std::optional<RunOutcome> crossover(const ContactProblem& p, BalanceMode balance, const InnerSettings& settings,
                                     const std::vector<int>& rows, Eigen::VectorXd& x) {
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   const int balanceRows = balance == BalanceMode::Dropped ? 0 : 6;
   const auto inequalities = static_cast<int>(p.inequality.rows());
   DualActiveSetQp qp;

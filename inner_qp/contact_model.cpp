@@ -61,6 +61,8 @@ const std::vector<ContactModelEntry>& contactModels() {
        makePyramidContactModel},
       {"wrench-cone", "Caron, Pham, Nakamura's wrench cone of a rectangle: the yaw moment bounded too",
        makeWrenchConeContactModel},
+      {"point", "a force at the contact point in the friction cone, no moment (knuckles, a fingertip)",
+       makePointContactModel},
   };
   return registry;
 }

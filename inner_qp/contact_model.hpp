@@ -15,6 +15,10 @@
 //   pyramid      (pyramid_contact.cpp)      the cone replaced by k inscribed facets
 //   wrench-cone  (wrench_cone_contact.cpp)  Caron, Pham, Nakamura (ICRA 2015): the yaw moment
 //                                           bounded as well
+//   point        (point_contact.cpp)        a force at the contact point in the friction cone,
+//                                           no moment (knuckles or a fingertip on a table)
+// A model's wrench has wrenchSize() components: the six of (f, m), or the three of f alone
+// (the moment is zero and is not a variable). Rows are always written over the six.
 
 #include <Eigen/Core>
 #include <initializer_list>
@@ -27,14 +31,18 @@
 
 namespace mcopt {
 
+class ContactModel;
+
 /// One contact of an inner problem: frame C in the world (z = normal into the robot),
-/// friction μ > 0, rectangle [xMin, xMax] × [yMin, yMax] in C.
+/// friction μ > 0, rectangle [xMin, xMax] × [yMin, yMax] in C (unused by a point contact), and
+/// its own contact model when it differs from the problem's.
 struct ContactSpec {
   std::string name;
   RigidTransform pose;
   double friction = 0.7;
   double xMin = 0, xMax = 0, yMin = 0, yMax = 0;
   double minNormalForce = 0.0;  ///< f_min ≥ 0
+  std::shared_ptr<const ContactModel> model;  ///< null: the problem's (ContactProblemSettings::model)
 };
 
 /// What a contact-model row bounds (results group violations by it).
@@ -85,6 +93,11 @@ class ContactModel {
   virtual std::string name() const = 0;
   /// Linear rows a contact has under the model.
   virtual int rowCount() const = 0;
+  /// Wrench components that are variables: 6, (f, m); or 3, f alone with m = 0 (its rows
+  /// then bound f only).
+  virtual int wrenchSize() const { return 6; }
+  /// Whether the model bounds the contact's extent (a rectangle must then be given).
+  virtual bool hasRectangle() const { return true; }
   /// One contact's linear rows; the first is the normal force's fz ≥ f_min (kind NormalForce,
   /// the row the sensitivity reads an unloaded contact's push from).
   ContactModelRows rows(const ContactSpec& contact) const;
@@ -127,5 +140,6 @@ std::shared_ptr<const ContactModel> makeContactModel(const std::string& name, co
 std::shared_ptr<const ContactModel> makeReportContactModel(const ContactModelOptions& options = {});
 std::shared_ptr<const ContactModel> makePyramidContactModel(const ContactModelOptions& options = {});
 std::shared_ptr<const ContactModel> makeWrenchConeContactModel(const ContactModelOptions& options = {});
+std::shared_ptr<const ContactModel> makePointContactModel(const ContactModelOptions& options = {});
 
 }  // namespace mcopt

@@ -13,12 +13,11 @@ namespace {
 void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const Eigen::MatrixXd>& wrenchToTorque,
               const Eigen::Ref<const Eigen::VectorXd>& tau0, const Vector6& balanceWrench,
               const Eigen::Ref<const Eigen::VectorXd>& weights, const Eigen::Ref<const Eigen::VectorXd>& linear,
-              const ContactProblemSettings& settings) {
-  const auto nc = static_cast<Eigen::Index>(contacts.size());
+              const ContactProblemSettings& settings, int columns) {
   const Eigen::Index n = tau0.size();
-  if (nc == 0) throw InputError("contacts: at least one contact is needed");
-  if (wrenchToTorque.rows() != n || wrenchToTorque.cols() != 6 * nc)
-    throw InputError("wrench_to_torque: expected " + std::to_string(n) + " × " + std::to_string(6 * nc) + ", got " +
+  if (contacts.empty()) throw InputError("contacts: at least one contact is needed");
+  if (wrenchToTorque.rows() != n || wrenchToTorque.cols() != columns)
+    throw InputError("wrench_to_torque: expected " + std::to_string(n) + " × " + std::to_string(columns) + ", got " +
                      std::to_string(wrenchToTorque.rows()) + " × " + std::to_string(wrenchToTorque.cols()));
   if (weights.size() != n || linear.size() != n)
     throw InputError("torque_weights, torque_linear: expected " + std::to_string(n) + " values each");
@@ -26,12 +25,11 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
       !linear.allFinite())
     throw InputError("inner problem data contain NaN or infinity");
   if ((weights.array() <= 0.0).any()) throw InputError("torque_weights: must all be positive");
-  if (!settings.model) throw InputError("inner problem: no contact model");
   if (!(settings.tikhonov >= 0.0)) throw InputError("tikhonov: must be non-negative");
   for (const ContactSpec& c : contacts) {
     const std::string where = "contact '" + c.name + "': ";
     if (!(c.friction > 0.0) || !std::isfinite(c.friction)) throw InputError(where + "mu must be positive");
-    if (!(c.xMin < c.xMax && c.yMin < c.yMax))
+    if (contactModelOf(c, settings).hasRectangle() && !(c.xMin < c.xMax && c.yMin < c.yMax))
       throw InputError(where + "rectangle must be [x_min, x_max, y_min, y_max] with x_min < x_max, y_min < y_max");
     if (!(c.minNormalForce >= 0.0)) throw InputError(where + "minimum normal force must be non-negative");
     if (!c.pose.rotation.allFinite() || !c.pose.translation.allFinite())
@@ -39,7 +37,29 @@ void validate(const std::vector<ContactSpec>& contacts, const Eigen::Ref<const E
   }
 }
 
+/// Contact i's balance columns: the wrench map's first `size` columns.
+void writeBalanceColumns(ContactProblem& p, int contact, const RigidTransform& pose) {
+  Eigen::Matrix<double, 6, 6> toWorld;
+  wrenchToWorld(pose, toWorld);
+  const int size = p.wrenchSize(contact);
+  p.balance.middleCols(p.contactColumn[static_cast<std::size_t>(contact)], size) = toWorld.leftCols(size);
+}
+
 }  // namespace
+
+const ContactModel& contactModelOf(const ContactSpec& c, const ContactProblemSettings& settings) {
+  if (c.model) return *c.model;
+  if (const auto own = settings.byContact.find(c.name); own != settings.byContact.end() && own->second)
+    return *own->second;
+  if (!settings.model) throw InputError("inner problem: no contact model");
+  return *settings.model;
+}
+
+std::vector<int> contactColumns(const std::vector<ContactSpec>& contacts, const ContactProblemSettings& settings) {
+  std::vector<int> columns{0};
+  for (const ContactSpec& c : contacts) columns.push_back(columns.back() + contactModelOf(c, settings).wrenchSize());
+  return columns;
+}
 
 ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
                                       const Eigen::Ref<const Eigen::MatrixXd>& J1,
@@ -47,39 +67,59 @@ ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,
                                       const Eigen::Ref<const Eigen::VectorXd>& weights,
                                       const Eigen::Ref<const Eigen::VectorXd>& linear,
                                       const ContactProblemSettings& settings) {
-  validate(contacts, J1, tau0, balanceWrench, weights, linear, settings);
   ContactProblem p;
+  p.contactColumn = contactColumns(contacts, settings);
+  const int m = p.contactColumn.back();
   const int nc = static_cast<int>(contacts.size());
+  // The whole wrench maps (six columns a contact) are accepted too: a force alone takes the
+  // first three of its contact's.
+  const bool whole = J1.cols() == 6 * nc && m != 6 * nc;
+  validate(contacts, J1, tau0, balanceWrench, weights, linear, settings, whole ? 6 * nc : m);
   p.contactCount = nc;
   p.tikhonov = settings.tikhonov;
-  p.hessian.resize(6 * nc, 6 * nc);
-  p.gradient.resize(6 * nc);
-  p.weightedWrenchToTorque.resize(J1.rows(), 6 * nc);
-  updateObjective(p, J1, tau0, weights, linear);
+  p.hessian.resize(m, m);
+  p.gradient.resize(m);
+  p.weightedWrenchToTorque.resize(J1.rows(), m);
+  if (whole) {
+    Eigen::MatrixXd columns(J1.rows(), m);
+    for (int i = 0; i < nc; ++i)
+      columns.middleCols(p.contactColumn[static_cast<std::size_t>(i)], p.wrenchSize(i)) =
+          J1.middleCols(6 * i, p.wrenchSize(i));
+    updateObjective(p, columns, tau0, weights, linear);
+  } else {
+    updateObjective(p, J1, tau0, weights, linear);
+  }
 
   // Balance (§5): the contact wrenches moved to the world origin add up to W.
-  p.balance.resize(6, 6 * nc);
-  for (int i = 0; i < nc; ++i) wrenchToWorld(contacts[i].pose, p.balance.middleCols<6>(6 * i));
+  p.balance.resize(6, m);
+  for (int i = 0; i < nc; ++i) writeBalanceColumns(p, i, contacts[static_cast<std::size_t>(i)].pose);
   p.balanceTarget = balanceWrench;
 
-  const ContactModel& model = *settings.model;
-  const int perContact = model.rowCount();
-  p.inequality.setZero(perContact * nc, 6 * nc);
-  p.inequalityBound.resize(perContact * nc);
+  // Each contact's rows, as its model writes them (over the six wrench components; a model
+  // whose wrench is the force alone writes none on the moment).
+  int rowCount = 0;
+  for (const ContactSpec& c : contacts) rowCount += contactModelOf(c, settings).rowCount();
+  p.inequality.setZero(rowCount, m);
+  p.inequalityBound.resize(rowCount);
+  int start = 0;
   for (int i = 0; i < nc; ++i) {
     const ContactSpec& c = contacts[static_cast<std::size_t>(i)];
+    const ContactModel& model = contactModelOf(c, settings);
     const ContactModelRows rows = model.rows(c);
-    const int start = perContact * i;
+    const int count = model.rowCount(), size = model.wrenchSize(), column = p.contactColumn[static_cast<std::size_t>(i)];
+    if (size < 6 && rows.rows.rightCols(6 - size).cwiseAbs().maxCoeff() != 0.0)
+      throw std::logic_error("contact model '" + model.name() + "': a row bounds a wrench component that is not a variable");
     p.contactRowStart.push_back(start);
     p.contactNames.push_back(c.name);
-    p.inequality.block(start, 6 * i, perContact, 6) = rows.rows;
-    p.inequalityBound.segment(start, perContact) = rows.bound;
+    p.inequality.block(start, column, count, size) = rows.rows.leftCols(size);
+    p.inequalityBound.segment(start, count) = rows.bound;
     for (const std::string& name : rows.names) p.rowNames.push_back(c.name + "." + name);
     p.rowKinds.insert(p.rowKinds.end(), rows.kinds.begin(), rows.kinds.end());
     p.contactCone.push_back(model.hasSecondOrderCone() ? static_cast<int>(p.cones.size()) : -1);
-    if (model.hasSecondOrderCone()) p.cones.push_back({6 * i, c.friction, i});
+    if (model.hasSecondOrderCone()) p.cones.push_back({column, c.friction, i});
+    start += count;
   }
-  p.contactRowStart.push_back(perContact * nc);
+  p.contactRowStart.push_back(start);
   return p;
 }
 
@@ -101,7 +141,21 @@ void updateObjective(ContactProblem& p, const Eigen::Ref<const Eigen::MatrixXd>&
 
 void setContactPose(ContactProblem& p, int contact, const RigidTransform& pose) {
   if (contact < 0 || contact >= p.contactCount) throw InputError("inner problem: no contact " + std::to_string(contact));
-  wrenchToWorld(pose, p.balance.middleCols<6>(6 * contact));
+  writeBalanceColumns(p, contact, pose);
+}
+
+Eigen::MatrixXd ContactProblem::wrenchRows(const Eigen::Ref<const Eigen::MatrixXd>& variableRows) const {
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(6 * contactCount, variableRows.cols());
+  for (int i = 0; i < contactCount; ++i)
+    out.middleRows(6 * i, wrenchSize(i)) = variableRows.middleRows(contactColumn[static_cast<std::size_t>(i)], wrenchSize(i));
+  return out;
+}
+
+Vector6 ContactProblem::contactWrench(const Eigen::Ref<const Eigen::VectorXd>& wrenches, int contact) const {
+  Vector6 wrench = Vector6::Zero();
+  const int size = wrenchSize(contact);
+  wrench.head(size) = wrenches.segment(contactColumn[static_cast<std::size_t>(contact)], size);
+  return wrench;
 }
 
 double ContactProblem::objective(const Eigen::Ref<const Eigen::VectorXd>& F) const {

@@ -15,6 +15,7 @@
 // which contact, so that nothing downstream assumes a layout.
 
 #include <Eigen/Core>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,9 @@ namespace mcopt {
 
 struct ContactProblemSettings {
   std::shared_ptr<const ContactModel> model = makeReportContactModel();
+  /// Contacts whose model is not `model`, by contact name (a scenario's `contacts[k].model`);
+  /// a ContactSpec's own `model` comes first.
+  std::map<std::string, std::shared_ptr<const ContactModel>> byContact;
   double tikhonov = 1e-9;   ///< ε added to H's diagonal; not part of the reported objective
 };
 
@@ -38,15 +42,17 @@ struct FrictionCone {
 };
 
 /// Problem data, sized once per contact set and overwritten per sample.
+/// Fc stacks each contact's wrench variables: (f, m), or f alone for a model whose wrenchSize()
+/// is 3 (contactColumn); m = Σ of those sizes, 6nc when every contact has six.
 struct ContactProblem {
   int contactCount = 0;
-  Eigen::MatrixXd hessian;                           ///< H, 6nc × 6nc, with ε
-  Eigen::VectorXd gradient;                          ///< c, 6nc
+  Eigen::MatrixXd hessian;                           ///< H, m × m, with ε
+  Eigen::VectorXd gradient;                          ///< c, m
   double constant = 0.0;                             ///< Σ w τ0² + l τ0: objective at Fc = 0
   double tikhonov = 0.0;
-  Eigen::Matrix<double, 6, Eigen::Dynamic> balance;  ///< wrenchToWorld, 6 × 6nc
+  Eigen::Matrix<double, 6, Eigen::Dynamic> balance;  ///< wrenchToWorld, 6 × m
   Vector6 balanceTarget = Vector6::Zero();           ///< W: world axes, about the world origin
-  Eigen::MatrixXd inequality;                        ///< G, rows × 6nc: G Fc ≤ bound
+  Eigen::MatrixXd inequality;                        ///< G, rows × m: G Fc ≤ bound
   Eigen::VectorXd inequalityBound;
   std::vector<FrictionCone> cones;                   ///< models with hasSecondOrderCone()
   /// Name of each linear row, "<contact>.<row>": fz_min, cop_x_max, cop_x_min, cop_y_max,
@@ -58,7 +64,20 @@ struct ContactProblem {
   /// its normal force's fz ≥ f_min. contactCount + 1 values.
   std::vector<int> contactRowStart;
   std::vector<int> contactCone;                      ///< contact i's cone in `cones`, or -1
-  Eigen::MatrixXd weightedWrenchToTorque;            ///< scratch of updateObjective, n × 6nc
+  /// Contact i's wrench variables are Fc[contactColumn[i], contactColumn[i + 1]): its wrench
+  /// (f, m) or its force f alone. contactCount + 1 values.
+  std::vector<int> contactColumn;
+  Eigen::MatrixXd weightedWrenchToTorque;            ///< scratch of updateObjective, n × m
+
+  int variableCount() const { return static_cast<int>(gradient.size()); }
+  int wrenchSize(int contact) const {
+    return contactColumn[static_cast<std::size_t>(contact) + 1] - contactColumn[static_cast<std::size_t>(contact)];
+  }
+  /// Contact i's wrench (f, m) in its frame from the stacked variables (m = 0 for a force alone).
+  Vector6 contactWrench(const Eigen::Ref<const Eigen::VectorXd>& wrenches, int contact) const;
+  /// Rows over the variables (a derivative of Fc) as rows over every contact's six wrench
+  /// components, zero for a moment that is not a variable.
+  Eigen::MatrixXd wrenchRows(const Eigen::Ref<const Eigen::MatrixXd>& variableRows) const;
 
   /// Σ w Γ² + l Γ at Fc, without the Tikhonov term (what results report).
   double objective(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
@@ -69,7 +88,16 @@ struct ContactProblem {
   double constraintViolation(const Eigen::Ref<const Eigen::VectorXd>& wrenches) const;
 };
 
-/// Assembles the problem. wrenchToTorque: n × 6nc; tau0, torqueWeights (> 0), torqueLinear:
+/// The model a contact has under the settings: its own, the settings' for its name, or the
+/// settings' default. Throws InputError when none is given.
+const ContactModel& contactModelOf(const ContactSpec& contact, const ContactProblemSettings& settings);
+
+/// Columns of a contact set (contactColumn): each contact's wrench size under its model, or
+/// the default one. Throws InputError for a contact set without a model.
+std::vector<int> contactColumns(const std::vector<ContactSpec>& contacts, const ContactProblemSettings& settings);
+
+/// Assembles the problem. wrenchToTorque: n × m (each contact's columns: the wrench map's six,
+/// or its first three for a force alone), or the whole maps, n × 6nc; tau0, torqueWeights (> 0), torqueLinear:
 /// n; balanceWrench: world axes about the world origin. Throws InputError naming the
 /// contact and field for sizes that disagree, μ ≤ 0, an empty rectangle or a non-finite value.
 ContactProblem assembleContactProblem(const std::vector<ContactSpec>& contacts,

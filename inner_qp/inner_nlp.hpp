@@ -28,7 +28,7 @@ class InnerNlp {
   InnerNlp(const ContactProblem& problem, BalanceMode balance, double coneSmoothing = 0.0, double band = 0.0)
       : p_(problem), mode_(balance), delta_(coneSmoothing), band_(band) {}
 
-  int variableCount() const { return 6 * p_.contactCount; }
+  int variableCount() const { return p_.variableCount(); }
   int equalityCount() const { return mode_ == BalanceMode::Equality ? 6 : 0; }
   int bandCount() const { return mode_ == BalanceMode::Band ? 12 : 0; }
   int inequalityCount() const { return static_cast<int>(p_.inequality.rows() + p_.cones.size()) + bandCount(); }
@@ -108,7 +108,7 @@ class InnerNlp {
       fz = -2.0 * c.friction * c.friction;
     }
   }
-  Eigen::Map<const Eigen::VectorXd> wrenches(const double* x) const { return {x, 6 * p_.contactCount}; }
+  Eigen::Map<const Eigen::VectorXd> wrenches(const double* x) const { return {x, p_.variableCount()}; }
 
  private:
   const ContactProblem& p_;

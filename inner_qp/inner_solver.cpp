@@ -77,7 +77,7 @@ double stationarity(const ContactProblem& p, const InnerResult& r, Eigen::Index 
 }  // namespace
 
 void finishResult(const ContactProblem& p, const double* x, InnerResult& r) {
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   r.wrenches = Eigen::Map<const Eigen::VectorXd>(x, n);
   r.objective = p.objective(r.wrenches);
   const double scale = p.dataScale();
@@ -102,7 +102,7 @@ void estimateMultipliers(const ContactProblem& p, InnerResult& r) {
   // surface normal (u, −μ) (coefficient ν ≥ 0, y = ν (−u, μ)) or, at the apex, the three
   // unit vectors on (fx, fy, fz) (coefficients −y: the dual-cone membership of y is then
   // checked by the KKT residual, not assumed).
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   const Eigen::Index rows = p.inequality.rows();
   const double apex = 1e-7 * p.dataScale();
   std::vector<std::pair<int, int>> columns;  // (active-set entry, component: -1 surface, 0..2 apex axis)
@@ -227,7 +227,7 @@ void solveWithElasticFallback(const ContactProblem& p, const InnerSettings& sett
     return outcome;
   };
   const auto start = std::chrono::steady_clock::now();
-  const int n = 6 * p.contactCount;
+  const int n = p.variableCount();
   const double scale = p.dataScale();
   Eigen::VectorXd x(n);
   if (r.wrenches.size() == n && r.wrenches.allFinite())

@@ -34,7 +34,7 @@ void innerObjectiveTermDerivatives(const ActuatorSet& actuators, const Eigen::Re
 }
 
 ContactSpec contactSpec(const ContactSurface& s, const RigidTransform& pose) {
-  return {s.name, pose, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0};
+  return {s.name, pose, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0, nullptr};
 }
 
 SampleProblem::SampleProblem(const DynamicsModel& model, const std::vector<ContactSurface>& contacts,
@@ -42,9 +42,10 @@ SampleProblem::SampleProblem(const DynamicsModel& model, const std::vector<Conta
   const int n = model.jointCount(), nc = static_cast<int>(contacts.size());
   std::vector<ContactSpec> specs;
   for (const ContactSurface& s : contacts) specs.push_back(contactSpec(s));
-  problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, 6 * nc), Eigen::VectorXd::Zero(n), Vector6::Zero(),
+  const int columns = contactColumns(specs, settings).back();
+  problem = assembleContactProblem(specs, Eigen::MatrixXd::Zero(n, columns), Eigen::VectorXd::Zero(n), Vector6::Zero(),
                                    Eigen::VectorXd::Ones(n), Eigen::VectorXd::Zero(n), settings);
-  wrenchToTorque.setZero(n, 6 * nc);
+  wrenchToTorque.setZero(n, columns);
   frames.resize(static_cast<std::size_t>(nc));
   weights.setZero(n);
   linear.setZero(n);
@@ -58,7 +59,9 @@ void SampleProblem::update(const DynamicsModel& model, const DynamicsData& data,
     const auto at = static_cast<int>(i);
     frames[i] = contactFrame(model, data, contacts[i].frame, contacts[i].placement);
     mcopt::wrenchToTorque(model, data, frames[i], block_);
-    wrenchToTorque.middleCols<6>(6 * at) = block_;
+    // The wrench map's columns of the contact's variables: all six, or the force's three.
+    const int size = problem.wrenchSize(at);
+    wrenchToTorque.middleCols(problem.contactColumn[i], size) = block_.leftCols(size);
     setContactPose(problem, at, frames[i].contactPose);
   }
   innerObjectiveTerms(actuators, v, a, weights, linear);
@@ -123,7 +126,8 @@ void MultiContactEvaluator::evaluateSample(Workspace& w, int s, double duration,
   r.status[static_cast<std::size_t>(s)] = result.status;
   r.iterations[s] = result.iterations;
   r.kktResidual[s] = result.kktResidual;
-  r.wrenches.col(s) = result.wrenches;
+  for (int i = 0; i < w.sample.problem.contactCount; ++i)
+    r.wrenches.col(s).segment<6>(6 * i) = w.sample.problem.contactWrench(result.wrenches, i);
   r.balanceSlack.col(s) = result.balanceSlack;
   // Γ = Γ0 − J1 F (4.8), then the motors' power with it.
   m.tau.col(s) = w.data.tau;

@@ -31,7 +31,8 @@ struct MultiContactSettings {
 ContactSpec contactSpec(const ContactSurface& surface, const RigidTransform& pose = RigidTransform{});
 
 /// One sample's inner problem, built from a Newton–Euler pass (formulation.md §5, §7): the
-/// contact frames, wrenchToTorque J1 (n × 6nc), the objective's per-joint terms, the balance
+/// contact frames, wrenchToTorque J1 (n × the problem's variables: six columns a contact, three
+/// for a force alone), the objective's per-joint terms, the balance
 /// at W0. Sized once; update() allocates nothing.
 struct SampleProblem {
   SampleProblem(const DynamicsModel& model, const std::vector<ContactSurface>& contacts,

@@ -15,7 +15,8 @@ ContactAdmissibilityRows::ContactAdmissibilityRows(const ContactSurface& surface
   toContact_.topLeftCorner<3, 3>() = pose.rotation.transpose();
   toContact_.bottomRightCorner<3, 3>() = pose.rotation.transpose();
   toContact_.bottomLeftCorner<3, 3>() = -pose.rotation.transpose() * skew(pose.translation);
-  AdmissibilityRows rows = model.model->admissibilityRows(contactSpec(surface), weight);
+  const ContactSpec spec = contactSpec(surface);
+  AdmissibilityRows rows = contactModelOf(spec, model).admissibilityRows(spec, weight);
   linearByWrench_ = rows.linear * toContact_;
   offset_ = std::move(rows.offset);
   quadraticRow_ = rows.quadraticRow;

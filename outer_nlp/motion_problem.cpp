@@ -700,7 +700,8 @@ Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParamete
       if (previous) sample->warmStartFrom(*previous);
       sample->evaluate(modelOf(s), w.data, nullptr, scenario_.actuators, w.v, w.a, false);
       for (std::size_t k = 0; k < which.size(); ++k)
-        wrenches[static_cast<std::size_t>(which[k])].col(s) = sample->innerResult().wrenches.segment<6>(6 * (1 + static_cast<int>(k)));
+        wrenches[static_cast<std::size_t>(which[k])].col(s) =
+            sample->problem().problem.contactWrench(sample->innerResult().wrenches, 1 + static_cast<int>(k));
       previous = std::move(sample);
     }
     forces_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
@@ -927,9 +928,10 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
     w.torque = sample.torque();
     b.y[outputs_.infeasibility()] = sample.infeasibility();
     const Eigen::VectorXd& F = sample.innerResult().wrenches;
-    b.wrenches.head<6>() = F.head<6>();
+    const ContactProblem& inner = sample.problem().problem;
+    b.wrenches.head<6>() = inner.contactWrench(F, 0);
     for (int i = 0, k = 1; i < contacts; ++i)
-      if (contactActive(i, s)) b.wrenches.segment<6>(6 * (1 + i)) = F.segment<6>(6 * k++);
+      if (contactActive(i, s)) b.wrenches.segment<6>(6 * (1 + i)) = inner.contactWrench(F, k++);
     if (derivatives) {
       b.dyDq.topRows(n) = sample.torqueDq();
       b.dyDv.topRows(n) = sample.torqueDv();

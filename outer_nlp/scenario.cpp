@@ -247,7 +247,7 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
     const YAML::Node entry = list[i];
     const std::string field = "contacts[" + std::to_string(i) + "]";
     // (A YAML::Node handle is never re-assigned: assignment writes through to the node it refers to.)
-    if (entry.IsMap()) yaml::rejectUnknownKeys(file, entry, field, {"surface", "window", "pose"});
+    if (entry.IsMap()) yaml::rejectUnknownKeys(file, entry, field, {"surface", "window", "pose", "model"});
     const YAML::Node nameNode = entry.IsMap() ? yaml::required(file, entry, "surface", field) : entry;
     const std::string name = yaml::text(file, nameNode, entry.IsMap() ? field + ".surface" : field);
     const auto surface = std::find_if(surfaces.begin(), surfaces.end(), [&](const ContactSurface& c) { return c.name == name; });
@@ -264,6 +264,9 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
         throw InputError(where(file, entry["window"] ? entry["window"] : entry["pose"], field) + "contact '" + name +
                          "' is on the reference body, which is fixed in the world for the whole motion: it takes no "
                          "window and no pose (reference_pose places it)");
+      if (entry.IsMap() && entry["model"])
+        throw InputError(where(file, entry["model"], field + ".model") + "contact '" + name +
+                         "' is on the reference body, whose contact model is the scenario's (inner.contact_model)");
       s.support = *surface;
       haveReference = true;
       continue;
@@ -272,6 +275,20 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
     c.surface = *surface;
     c.origin = where(file, entry, field);
     c.origin.resize(c.origin.size() - 2);
+    if (entry.IsMap() && entry["model"]) {
+      const YAML::Node model = entry["model"];
+      const std::string modelName = yaml::text(file, model, field + ".model");
+      const auto& names = contactModelNames();
+      if (std::find(names.begin(), names.end(), modelName) == names.end())
+        throw InputError(where(file, model, field + ".model") + "unknown contact model '" + modelName + "' (expected " +
+                         contactModelList() + ")");
+      if (modelName == "pyramid")
+        throw InputError(where(file, model, field + ".model") +
+                         "a contact's own model takes no parameters: the pyramid is inner.contact_model's, with "
+                         "inner.pyramid_facets");
+      s.inner.problem.byContact[name] = makeContactModel(modelName);
+      c.modelOrigin = where(file, model, field + ".model");
+    }
     c.end = s.duration.initial;
     if (entry.IsMap() && entry["window"]) {
       const YAML::Node w = entry["window"];
@@ -334,6 +351,10 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
     options.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
   }
   s.inner.problem.model = makeContactModel(modelName, options);
+  if (s.inner.problem.model->wrenchSize() < 6)
+    throw InputError(where(file, node["contact_model"], "inner.contact_model") + "the " + modelName +
+                     " model holds a force alone, no moment: give it to a contact (contacts[k].model: " + modelName +
+                     "), not to every contact — the reference contact carries moments");
   if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
   if (node["polish"]) s.inner.solver.polish = flag(file, node["polish"], "inner.polish");
   if (node["kkt_backend"]) {
@@ -599,6 +620,10 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     }
   }
   if (contactForces) s.contactForces = *contactForces;
+  for (const EnvironmentContact& c : s.contacts)
+    if (!c.modelOrigin.empty() && s.contactForces != ContactForces::Bilevel)
+      throw InputError(c.modelOrigin + "a contact's own model needs contact_forces: bilevel (the single-level "
+                       "formulations hold one model, inner.contact_model, on every wrench variable)");
   if (root["force_control_points"])
     s.forceControlPoints = integerField(file, root["force_control_points"], "force_control_points", 4);
   if (root["inner"]) readInnerSettings(file, root["inner"], s);

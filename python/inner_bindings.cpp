@@ -95,10 +95,18 @@ void bindInner(py::module_& m) {
         return out;
       },
       "The registered inner solvers, name → what it is, in the order the documents list them.");
+  m.def(
+      "contact_models",
+      [] {
+        py::dict out;
+        for (const ContactModelEntry& e : contactModels()) out[py::str(e.name)] = e.description;
+        return out;
+      },
+      "The registered contact models, name → what it is, in the order the documents list them.");
   py::class_<InnerProblemHandle, std::shared_ptr<InnerProblemHandle>>(m, "InnerProblem", R"doc(
 One sample's inner problem (formulation.md §7): the contact wrenches F_i (in each contact's
 frame) that minimise Σ w Γ² + l Γ with Γ = tau0 − wrench_to_torque · F, subject to the balance
-B F = W and each contact's model (report, pyramid or wrench-cone; `pyramid_facets`, default 8,
+B F = W and each contact's model (report, pyramid, wrench-cone or point — a force alone, 3 variables; `pyramid_facets`, default 8,
 only with the pyramid). Built from arrays (the
 fields of a `mcopt inner` problem, docs/theory/inner-problem.md) or from a robot state and contact
 surfaces (InnerProblem.from_state).)doc")
@@ -148,7 +156,7 @@ world origin. Sizes, values and keys are checked as `mcopt inner` checks a probl
             cli::InnerProblemData data;
             for (std::size_t i = 0; i < surfaces.size(); ++i) {
               const ContactSurface& s = surfaces[i];
-              data.contacts.push_back({s.name, sample.frames[i].contactPose, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0});
+              data.contacts.push_back({s.name, sample.frames[i].contactPose, s.friction, s.xMin, s.xMax, s.yMin, s.yMax, 0.0, nullptr});
             }
             data.wrenchToTorque = sample.wrenchToTorque;
             data.tau0 = d.data.tau;
@@ -165,27 +173,31 @@ dynamics' robot, as the bilevel formulation builds it at a sample: Γ0 and W0 fr
 J1 from the contact frames, w = R/(K N)² and l from the actuators (formulation.md §5–§7).)doc")
       .def_property_readonly("contact_count", [](const InnerProblemHandle& p) { return p.problem.contactCount; }, "number of contacts nc (6 nc wrench components)")
       .def_property_readonly("contact_names", [](const InnerProblemHandle& p) { return p.problem.contactNames; }, "the contacts, in the order of the stacked wrenches")
-      .def_property_readonly("contact_model", [](const InnerProblemHandle& p) { return p.modelName; }, "'report', 'pyramid' or 'wrench-cone'")
+      .def_property_readonly("contact_model", [](const InnerProblemHandle& p) { return p.modelName; }, "the contact model's name (mcopt.contact_models())")
       .def_property_readonly("row_names", [](const InnerProblemHandle& p) { return p.problem.rowNames; },
                              "names of the linear rows G F ≤ g, '<contact>.<row>'")
+      .def_property_readonly("variable_count", [](const InnerProblemHandle& p) { return p.problem.variableCount(); },
+                             "m: the stacked wrench variables, 6 a contact (3 for a point contact: the force alone)")
       .def_property_readonly("hessian", [](const InnerProblemHandle& p) { return matrixToNumpy(p.problem.hessian); },
                              "H of ½ Fᵀ H F + cᵀ F, with the Tikhonov term")
       .def_property_readonly("gradient", [](const InnerProblemHandle& p) { return vectorToNumpy(p.problem.gradient); }, "c of ½ Fᵀ H F + cᵀ F")
       .def_property_readonly("balance", [](const InnerProblemHandle& p) { return matrixToNumpy(p.problem.balance); },
-                             "B (6, 6 nc): the wrenches to the world, about its origin")
+                             "B (6, m): the wrenches to the world, about its origin")
       .def_property_readonly("balance_target", [](const InnerProblemHandle& p) { return vectorToNumpy(p.problem.balanceTarget); }, "W (6,): the wrench the contacts must balance, world axes about the world origin")
       .def_property_readonly("inequality", [](const InnerProblemHandle& p) { return matrixToNumpy(p.problem.inequality); }, "G of the linear rows G F ≤ g (rows named by row_names)")
       .def_property_readonly("inequality_bound", [](const InnerProblemHandle& p) { return vectorToNumpy(p.problem.inequalityBound); }, "g of the linear rows G F ≤ g")
       .def(
           "objective",
           [](const InnerProblemHandle& p, const py::object& wrenches) {
-            return p.problem.objective(vectorArgument(wrenches, "wrenches", 6 * p.problem.contactCount));
+            return p.problem.objective(vectorArgument(wrenches, "wrenches", p.problem.variableCount()));
           },
-          py::arg("wrenches"), "Σ w Γ² + l Γ at the stacked wrenches (6 nc,), without the Tikhonov term.")
+          py::arg("wrenches"),
+          "Σ w Γ² + l Γ at the stacked wrench variables (variable_count,: 6 a contact, 3 for a point contact), "
+          "without the Tikhonov term.")
       .def(
           "constraint_violation",
           [](const InnerProblemHandle& p, const py::object& wrenches) {
-            return p.problem.constraintViolation(vectorArgument(wrenches, "wrenches", 6 * p.problem.contactCount));
+            return p.problem.constraintViolation(vectorArgument(wrenches, "wrenches", p.problem.variableCount()));
           },
           py::arg("wrenches"), "Largest violation of the balance, the linear rows and the cones (0 when feasible).")
       .def(
@@ -201,7 +213,7 @@ An inner solver's result: status ('optimal', 'infeasible' with the least-norm ba
           [](const InnerResultHandle& r) {
             const int nc = r.problem->problem.contactCount;
             Eigen::MatrixXd w(nc, 6);
-            for (int i = 0; i < nc; ++i) w.row(i) = r.result.wrenches.segment<6>(6 * i).transpose();
+            for (int i = 0; i < nc; ++i) w.row(i) = r.problem->problem.contactWrench(r.result.wrenches, i).transpose();
             return matrixToNumpy(w);
           },
           "(nc, 6): each contact's (fx, fy, fz, mx, my, mz) in its own frame")
@@ -259,7 +271,7 @@ An inner solver by its registered name (`mcopt.inner_solvers()`: name → what i
             out->problem = problem;
             // Consecutive samples: the previous result is the starting point (as `mcopt inner`
             // does along its list), when it has this problem's size.
-            if (previous && previous->result.wrenches.size() == 6 * problem->problem.contactCount)
+            if (previous && previous->result.wrenches.size() == problem->problem.variableCount())
               out->result = previous->result;
             if (s.name == "ipopt") {  // MUMPS: one Ipopt at a time in the process (bindings.hpp)
               py::gil_scoped_release release;

@@ -13,11 +13,11 @@ BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurf
       solver_(makeInnerSolver(settings.solverName, settings.solver)),
       sensitivity_(sensitivity) {
   if (contacts_.empty()) throw InputError("bilevel sample: no contact surface given");
-  const int n = model.jointCount(), nc = contactCount();
+  const int n = model.jointCount(), variables = sample_.problem.variableCount();
   torque_.setZero(n), g_.setZero(n), linearDv_.setZero(n), linearDa_.setZero(n);
   for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_, &fixedDq_, &fixedDv_, &fixedDa_})
     m->setZero(n, n);
-  dF_.setZero(6 * nc, 3 * n), stationarity_.setZero(6 * nc, 3 * n), balance_.setZero(6, 3 * n);
+  dF_.setZero(variables, 3 * n), stationarity_.setZero(variables, 3 * n), balance_.setZero(6, 3 * n);
   for (auto* m : {&dBFdq_, &dLeastSlackBFdq_, &dWorld_, &dTorqueT_, &dWorldT_}) m->setZero(6, n);
   for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
   // Room for the largest active set, so that warm starts copy without allocating.
@@ -29,7 +29,9 @@ BilevelSample::BilevelSample(BilevelSample&&) noexcept = default;
 BilevelSample& BilevelSample::operator=(BilevelSample&&) noexcept = default;
 
 void BilevelSample::warmStartFrom(const BilevelSample& other) {
-  if (other.contactCount() != contactCount() || !other.hasResult()) return;
+  if (other.contactCount() != contactCount() || !other.hasResult() ||
+      other.sample_.problem.contactColumn != sample_.problem.contactColumn)
+    return;
   result_.wrenches = other.result_.wrenches;
   result_.activeSet = other.result_.activeSet;
   result_.inequalityMultipliers = other.result_.inequalityMultipliers;
@@ -58,7 +60,7 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
   dJ1Fdq_.setZero();
   dBFdq_.setZero();
   for (int i = 0; i < nc; ++i) {
-    const Vector6 wrench = result_.wrenches.segment<6>(6 * i);
+    const Vector6 wrench = sample_.problem.contactWrench(result_.wrenches, i);
     wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
     dJ1Fdq_ += dTorque_;
     dBFdq_ += dWorld_;
@@ -68,7 +70,7 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
   if (result_.status == InnerStatus::Infeasible) {
     dLeastSlackBFdq_.setZero();
     for (int i = 0; i < nc; ++i) {
-      const Vector6 wrench = result_.leastSlackWrenches.segment<6>(6 * i);
+      const Vector6 wrench = sample_.problem.contactWrench(result_.leastSlackWrenches, i);
       wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
       dLeastSlackBFdq_ += dWorld_;
     }
@@ -89,7 +91,10 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
     for (int i = 0; i < nc; ++i) {
       transposedWrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], g_,
                                      result_.balanceMultipliers, dTorqueT_, dWorldT_);
-      stationarity_.block(6 * i, 0, 6, n) = dWorldT_ - dTorqueT_;
+      // The rows of the contact's variables: all six, or the force's three.
+      const int size = sample_.problem.wrenchSize(i);
+      stationarity_.block(sample_.problem.contactColumn[static_cast<std::size_t>(i)], 0, size, n) =
+          (dWorldT_ - dTorqueT_).topRows(size);
     }
     const auto& weights = sample_.weights;
     scaled_.noalias() = 2.0 * weights.asDiagonal() * (d->dtauDq - dJ1Fdq_);

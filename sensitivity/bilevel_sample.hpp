@@ -59,7 +59,7 @@ class BilevelSample {
   /// right-hand side of dF*/d(q, q̇, q̈) (InnerSensitivity::kktMatrix, rightHandSide).
   const Eigen::MatrixXd& kktMatrix() const { return sensitivity_.kktMatrix(); }
   void kktRightHandSide(Eigen::MatrixXd& rhs) const { sensitivity_.rightHandSide(stationarity_, balance_, rhs); }
-  /// dF*/d(q, q̇, q̈) solved elsewhere (6nc × 3n); the torque derivatives follow (4.8).
+  /// dF*/d(q, q̇, q̈) solved elsewhere (wrench variables × 3n); the torque derivatives follow (4.8).
   void setWrenchDerivative(const Eigen::Ref<const Eigen::MatrixXd>& dF);
 
   /// Starts the next solve from `other`'s result (a neighbouring sample with the same contacts).
@@ -77,7 +77,7 @@ class BilevelSample {
   const Eigen::RowVectorXd& infeasibilityDq() const { return dInfeasibilityDq_; }
   const Eigen::RowVectorXd& infeasibilityDv() const { return dInfeasibilityDv_; }
   const Eigen::RowVectorXd& infeasibilityDa() const { return dInfeasibilityDa_; }
-  /// dF*/d(q, q̇, q̈): 6nc × 3n (zero when the sample has no derivative).
+  /// dF*/d(q, q̇, q̈): wrench variables (problem().problem.contactColumn) × 3n (zero when the sample has no derivative).
   const Eigen::MatrixXd& wrenchesDstate() const { return dF_; }
   /// The last evaluation had an optimal inner result and so an exact dF*.
   bool hasWrenchDerivative() const { return hasWrenchDerivative_; }

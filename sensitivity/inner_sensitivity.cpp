@@ -213,7 +213,7 @@ const SensitivityDiagnostics& InnerSensitivity::diagnostics() const { return imp
 
 const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& p, const InnerResult& r) {
   Impl& m = *impl_;
-  const int nc = p.contactCount, n = 6 * nc;
+  const int nc = p.contactCount, n = p.variableCount();
   if (r.status != InnerStatus::Optimal)
     throw InputError(std::string("sensitivity: the inner result is ") + toString(r.status) +
                      ", not optimal: no derivative of the optimal wrenches exists there");
@@ -259,14 +259,15 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     // The contact's rows and cone, as its model laid them out (contact_problem.hpp).
     const int fzRow = p.normalForceRow(i);
     const int rowEnd = p.contactRowStart[static_cast<std::size_t>(i) + 1];
-    const double fz = F[6 * i + 2];
+    const int column = p.contactColumn[static_cast<std::size_t>(i)], components = p.wrenchSize(i);
+    const double fz = F[column + 2];
     const int cone = p.contactCone[static_cast<std::size_t>(i)];
     // Held at zero by its fz_min row or by its cone's apex (the active-set method certifies
     // an unloaded contact through the cone's planes, whose multipliers make y_z).
     const bool apex = cone >= 0 && m.active[static_cast<std::size_t>(rowCount + cone)];
     // An interior-point result stops near the apex, not on it: a contact whose normal and
     // shear forces are both negligible is unloaded too (never a curvature ν / ‖f_t‖ there).
-    const double shearNorm = F.segment<2>(6 * i).norm();
+    const double shearNorm = F.segment<2>(column).norm();
     const bool nearApex = std::abs(fz) <= m.settings.unloadedForce * forceScale &&
                           shearNorm <= m.settings.unloadedForce * forceScale;
     if ((m.active[static_cast<std::size_t>(fzRow)] || apex) && nearApex) {
@@ -277,7 +278,8 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
       if (!(push > strict)) ++m.diagnostics.weaklyActive;
       bool yawHeld = false;
       for (int k = fzRow; k < rowEnd; ++k) yawHeld |= p.rowKinds[static_cast<std::size_t>(k)] == ContactRowKind::Yaw;
-      for (int component = 0; component < (yawHeld ? 6 : 5); ++component) addUnit(6 * i + component);
+      // f and m_x, m_y pinned (m_z too where the yaw is bounded); a force alone: f.
+      for (int component = 0; component < std::min(components, yawHeld ? 6 : 5); ++component) addUnit(column + component);
       continue;
     }
     for (int k = fzRow; k < rowEnd; ++k) {
@@ -377,7 +379,7 @@ void InnerSensitivity::solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationar
   const int n = m.variables, size = m.diagnostics.size;
   if (size == 0) throw InputError("sensitivity: solve before factorize");
   if (dStationarity.rows() != n || dBalance.rows() != 6 || dStationarity.cols() != dBalance.cols())
-    throw InputError("sensitivity: right-hand sides must be 6nc × m and 6 × m");
+    throw InputError("sensitivity: right-hand sides must be (wrench variables) × m and 6 × m");
   // Buffers reused from call to call (allocation-free for the same shapes: the per-sample
   // path of MultiContactGradientEvaluator).
   // The system's size follows the active set from sample to sample: the buffers have the

@@ -87,15 +87,15 @@ class InnerSensitivity {
   const SensitivityDiagnostics& factorize(const ContactProblem& problem, const InnerResult& result);
   const SensitivityDiagnostics& diagnostics() const;
 
-  /// m parameter directions at once. dStationarity: 6nc × m, ∂(∇_F L)/∂p at fixed F and
-  /// multipliers; dBalance: 6 × m, ∂(B F − W)/∂p at fixed F. Writes dWrenches (6nc × m) and,
+  /// m parameter directions at once. dStationarity: (wrench variables, 6nc for six-component contacts) × m, ∂(∇_F L)/∂p at fixed F and
+  /// multipliers; dBalance: 6 × m, ∂(B F − W)/∂p at fixed F. Writes dWrenches (variables × m) and,
   /// when given, dBalanceMultipliers (6 × m). The contact rows do not depend on p (they live
   /// in the contact frames).
   void solve(const Eigen::Ref<const Eigen::MatrixXd>& dStationarity, const Eigen::Ref<const Eigen::MatrixXd>& dBalance,
              Eigen::MatrixXd& dWrenches, Eigen::MatrixXd* dBalanceMultipliers = nullptr) const;
 
-  /// The data sensitivities of `mcopt inner --sensitivity`: dF/dτ0 (6nc × n) and dF/dW
-  /// (6nc × 6), from ∂c/∂τ0 = −2 J1ᵀ diag(w) (the problem's weightedWrenchToTorque) and
+  /// The data sensitivities of `mcopt inner --sensitivity`: dF/dτ0 (variables × n) and dF/dW
+  /// (variables × 6), from ∂c/∂τ0 = −2 J1ᵀ diag(w) (the problem's weightedWrenchToTorque) and
   /// ∂(B F − W)/∂W = −1.
   void dataSensitivities(const ContactProblem& problem, Eigen::MatrixXd& dWrenchesDtau0,
                          Eigen::MatrixXd& dWrenchesDbalance) const;

@@ -68,7 +68,8 @@ void MultiContactGradientEvaluator::prepareSample(Workspace& w, int s, double du
   r.status[static_cast<std::size_t>(s)] = inner.status;
   r.iterations[s] = inner.iterations;
   r.kktResidual[s] = inner.kktResidual;
-  r.wrenches.col(s) = inner.wrenches;
+  for (int i = 0; i < sample.contactCount(); ++i)
+    r.wrenches.col(s).segment<6>(6 * i) = sample.problem().problem.contactWrench(inner.wrenches, i);
   r.balanceSlack.col(s) = inner.balanceSlack;
   motion.tau.col(s) = sample.torque();
   grad.diagnostics[static_cast<std::size_t>(s)] = sample.diagnostics();
@@ -115,10 +116,10 @@ void MultiContactGradientEvaluator::solveAllSamples() {
     throw InputError(std::string("all-samples KKT factorisation (") + toString(sensitivitySettings_.backend) + ") failed");
   Eigen::MatrixXd& solution = stacked;
   allSamplesFactor_->solveInPlace(solution);
-  const int nc = static_cast<int>(contacts_.size());
   for (int s = 0; s < count; ++s)
     if (offset[static_cast<std::size_t>(s)] >= 0)
-      bilevel_[static_cast<std::size_t>(s)].setWrenchDerivative(solution.middleRows(offset[static_cast<std::size_t>(s)], 6 * nc));
+      bilevel_[static_cast<std::size_t>(s)].setWrenchDerivative(solution.middleRows(
+          offset[static_cast<std::size_t>(s)], bilevel_[static_cast<std::size_t>(s)].problem().problem.variableCount()));
 }
 
 void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double duration, MultiContactResult& r,

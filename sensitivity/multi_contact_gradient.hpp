@@ -33,8 +33,10 @@ class SparseKktFactor;
 
 struct SampleWrenchJacobian {
   Eigen::VectorXi parameters;  ///< global parameter index of each column
-  Eigen::MatrixXd dFdx;        ///< 6nc × (jointCount · k)
-  Eigen::VectorXd dFdT;        ///< 6nc
+  /// Rows: the inner problem's wrench variables (ContactProblem::contactColumn; 6nc when every
+  /// contact has six components, three for a force alone).
+  Eigen::MatrixXd dFdx;        ///< variables × (jointCount · k)
+  Eigen::VectorXd dFdT;        ///< variables
 };
 
 struct MultiContactGradient {

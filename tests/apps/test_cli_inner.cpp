@@ -140,7 +140,7 @@ TEST_CASE("inner: bad input names the file and field", "[cli][inner][input]") {
   bad["problems"][0].erase("balance_wrench");
   expectError(bad, "", {"problems[0]", "missing 'balance_wrench'"});
   expectError(good, " --solver qpoases", {"solver", "expected " + innerSolverList(), "'qpoases'"});
-  expectError(good, " --contact-model soft", {"--contact-model", "report, pyramid or wrench-cone"});
+  expectError(good, " --contact-model soft", {"--contact-model", "report, pyramid, wrench-cone or point"});
   expectError(good, " --pyramid-facets 6", {"pyramid facets", "only the pyramid contact model has facets"});
   expectError(good, " --contact-model pyramid --pyramid-facets 2", {"pyramid facets", "at least 3"});
   const auto r = test::runMcopt("inner --problems " + test::quoted(dir.path() / "missing.json"));

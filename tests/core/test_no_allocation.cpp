@@ -162,12 +162,16 @@ struct ContactCase {
   bool warm;     ///< the active-set method warm-started from the previous sample
 };
 
-/// 2–4 contacts × each model × warm and cold (formulation.md §7).
+/// 2–4 contacts × each model × warm and cold (formulation.md §7). A model whose wrench is a
+/// force alone (point) is the hands' own, beside wrench-cone soles.
 std::vector<ContactCase> contactCases() {
   std::vector<ContactCase> cases;
-  for (const std::string& model : contactModelNames())
+  for (const std::string& model : contactModelNames()) {
+    const bool handsOnly = makeContactModel(model)->wrenchSize() < 6;
     for (const int contacts : {2, 3, 4})
-      for (const bool warm : {true, false}) cases.push_back({model, contacts, warm});
+      for (const bool warm : {true, false})
+        if (!handsOnly || contacts > 2) cases.push_back({model, contacts, warm});
+  }
   return cases;
 }
 
@@ -187,6 +191,11 @@ struct HalfSitting {
   MultiContactSettings settings(const ContactCase& c) const {
     MultiContactSettings s;
     s.problem.model = makeContactModel(c.model);
+    if (s.problem.model->wrenchSize() < 6) {
+      for (const ContactSurface& hand : first(c.contacts))
+        if (hand.name.find("hand") != std::string::npos) s.problem.byContact[hand.name] = s.problem.model;
+      s.problem.model = makeContactModel("wrench-cone");
+    }
     s.solver.warmStart = c.warm;
     return s;
   }

@@ -13,8 +13,8 @@ using Catch::Matchers::Contains;
 namespace {
 
 std::vector<ContactSpec> twoContacts() {
-  ContactSpec foot{"foot", {}, 0.7, -0.1, 0.13, -0.065, 0.065, 0.0};
-  ContactSpec hand{"hand", {}, 0.5, -0.04, 0.04, -0.025, 0.025, 0.0};
+  ContactSpec foot{"foot", {}, 0.7, -0.1, 0.13, -0.065, 0.065, 0.0, nullptr};
+  ContactSpec hand{"hand", {}, 0.5, -0.04, 0.04, -0.025, 0.025, 0.0, nullptr};
   // A hand on a wall: normal into the robot along world −x.
   hand.pose.rotation = rotationFromRpy(0.0, -std::numbers::pi / 2, 0.3);
   hand.pose.translation = Vector3(0.4, -0.2, 1.0);

@@ -81,6 +81,38 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
   }
 }
 
+TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact derivatives and carries no moment",
+          "[outer][multi-contact][contact]") {
+  // The contact model of one contact (contacts[k].model: point): its inner problem has three
+  // variables for the hand, the sensitivity its own layout; the outer gradient and Jacobian
+  // against central differences as for the other formulations' hands above.
+  Scenario s = weightShift(12);
+  s.contactForces = ContactForces::Bilevel;
+  s.fixStart = s.fixEnd = false;
+  addHandContact(s, 0.7, 1.7);
+  s.inner.problem.model = makeContactModel("wrench-cone");
+  s.inner.problem.byContact["r_hand"] = makeContactModel("point");
+  MotionProblem problem(s);
+  Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 7);
+  const test::DerivativeErrors e = test::derivativeErrors(problem, x, 1e-6);
+  INFO("gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern " << e.offPattern
+                   << "; infeasible samples " << problem.infeasibleSamples());
+  CHECK(e.gradient < 1e-6);
+  CHECK(e.jacobian < 1e-6);
+  CHECK(e.offPattern < 1e-6);
+  const SampledPhysics physics = problem.sampledPhysics(x);
+  int handLoaded = 0;
+  for (int k = 0; k < physics.time.size(); ++k) {
+    if (!physics.active[2][static_cast<std::size_t>(k)]) continue;
+    const Eigen::VectorXd hand = physics.wrenches[2].col(k);
+    CHECK(hand.tail<3>().cwiseAbs().maxCoeff() == 0.0);  // no moment: not a variable
+    CHECK(hand.head<2>().norm() <= s.contacts.back().surface.friction * hand[2] + 1e-9);  // its friction cone
+    handLoaded += hand[2] > 1.0;
+  }
+  WARN("samples with the point hand loaded: " << handLoaded);
+  CHECK(handLoaded > 0);
+}
+
 TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted and steered by an exact row",
           "[outer][multi-contact]") {
   // A fast, large motion that the two soles cannot carry at some samples (tip or slip).

@@ -157,6 +157,31 @@ def test_the_registry_lists_the_solvers_in_document_order():
         assert mcopt.InnerSolver(name).name == name
 
 
+def test_the_registry_lists_the_contact_models():
+    models = mcopt.contact_models()
+    assert list(models) == ["report", "pyramid", "wrench-cone", "point"]
+    assert all(isinstance(d, str) and d for d in models.values())
+    assert set(MODELS) < set(models)
+
+
+def test_a_point_hand_carries_a_force_alone(hrp2):
+    """The point model (a force at the contact point, no moment) on every contact of a problem
+    built from arrays: three variables a contact, the whole wrench maps accepted, moments zero."""
+    data = motion_problems(hrp2, "report", 6)[-1].to_dict()  # both soles and the right hand
+    p = mcopt.InnerProblem(**data, contact_model="point")
+    assert p.variable_count == 9 and p.hessian.shape == (9, 9) and p.balance.shape == (6, 9)
+    r = mcopt.InnerSolver().solve(p)
+    assert r.status == "optimal"  # measured: three points hold this sample
+    assert r.wrenches.shape == (3, 6)
+    np.testing.assert_array_equal(r.wrenches[:, 3:], 0.0)
+    assert p.constraint_violation(r.wrenches[:, :3].reshape(-1)) < 1e-6
+    # Two points alone cannot hold a moment about the line through them: the first sample
+    # (both soles as points) is infeasible, where the soles' own model holds it.
+    two = motion_problems(hrp2, "report", 6)[0].to_dict()
+    assert mcopt.InnerSolver().solve(mcopt.InnerProblem(**two, contact_model="point")).status == "infeasible"
+    assert mcopt.InnerSolver().solve(mcopt.InnerProblem(**two, contact_model="wrench-cone")).status == "optimal"
+
+
 def test_bad_types_and_names_raise(hrp2):
     data = motion_problems(hrp2, "report", 2)[0].to_dict()
     with pytest.raises(ValueError, match="tau0"):
