@@ -126,15 +126,16 @@ Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, 
   for (Eigen::Index k = 0; k < values.size(); ++k) jacobian(problem.jacobianRows()[k], problem.jacobianColumns()[k]) += values[k];
   const SampledPhysics physics = problem.sampledPhysics(x);
   Eigen::VectorXd curvedX = x.head(curved);
-  auto states = [&](bool acceleration) {
-    return test::centralDifferences(curvedX, 1e-4, [&] {
-      Eigen::VectorXd probe = x;
-      probe.head(curved) = curvedX;
-      const SampledPhysics p = problem.sampledPhysics(probe);
-      return Eigen::VectorXd((acceleration ? p.a : p.v).reshaped());  // index s · n + j
-    });
-  };
-  const Eigen::MatrixXd dv = states(false), da = states(true);
+  // q̇ and q̈ of every sample from one sweep of central differences (index s · n + j, q̇ first).
+  const Eigen::MatrixXd dStates = test::centralDifferences(curvedX, 1e-4, [&] {
+    Eigen::VectorXd probe = x;
+    probe.head(curved) = curvedX;
+    const SampledPhysics p = problem.sampledPhysics(probe);
+    Eigen::VectorXd stacked(p.v.size() + p.a.size());
+    stacked << p.v.reshaped(), p.a.reshaped();
+    return stacked;
+  });
+  const Eigen::MatrixXd dv = dStates.topRows(n * N), da = dStates.bottomRows(n * N);
   std::vector<int> torqueRow(static_cast<std::size_t>(n * N), -1), epigraphRow(static_cast<std::size_t>(n * N), -1);
   for (int r = 0; r < problem.constraintCount(); ++r) {
     if (problem.rowKind(r) != ConstraintKind::TorqueLimit && problem.rowKind(r) != ConstraintKind::Epigraph) continue;
