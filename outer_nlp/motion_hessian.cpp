@@ -111,7 +111,7 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
   if (throughWrenches) {
     sampleOutputs(s, h.probeX, true, w, probe);  // the point's ∂rows/∂W_ref and ∂W_ref/∂z in w
     h.wrenchWeights.setZero();
-    for (int r = 0; r < outputs_.rowsPerContact; ++r)
+    for (int r = 0; r < support_.rowCount(); ++r)
       h.wrenchWeights += multipliers[outputs_.referenceRow(r)] * w.rowsByReference.row(r).transpose();
     auto J = h.wrenchJacobian.leftCols(d), CJ = h.curvedWrenchJacobian.leftCols(d);
     referenceWrenchJacobian(s, w, J);
@@ -142,7 +142,7 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
     h.fixedWeights[outputs_.power(j)] = 0.0;
   }
   if (throughWrenches)  // their rows' weights are on the wrenches now
-    h.fixedWeights.segment(outputs_.referenceRow(0), outputs_.rowsPerContact * (1 + outputs_.contacts)).setZero();
+    h.fixedWeights.segment(outputs_.referenceRow(0), outputs_.contactRowStart.back()).setZero();
   // Σ_o w_o ∇y_o at the probed state (and the wrench weights' share): what the stencils difference.
   auto probeGradient = [&](Eigen::Ref<Eigen::VectorXd> gradient) {
     sampleOutputs(s, h.probeX, true, w, probe);

@@ -212,7 +212,8 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
     throw InputError("motion problem: the torque-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());
-  outputs_.joints = jointCount_, outputs_.contacts = contacts, outputs_.rowsPerContact = support_.rowCount();
+  outputs_.joints = jointCount_, outputs_.contacts = contacts;
+  outputs_.contactRowStart = {0, support_.rowCount()};
   forceStart_ = parameterCount_ + (durationIsFree() ? 1 : 0);
   for (const EnvironmentContact& c : scenario_.contacts) {
     windows_.push_back({c.start / scenario_.duration.initial, std::min(1.0, c.end / scenario_.duration.initial)});
@@ -223,6 +224,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
           insideWindow(sampleTimes_[static_cast<std::size_t>(s)], windows_.back(), sampleSides_[static_cast<std::size_t>(s)]);
     active_.push_back(std::move(active));
     contactRows_.emplace_back(c.surface, RigidTransform{}, weight_, scenario_.inner.problem);
+    outputs_.contactRowStart.push_back(outputs_.contactRowStart.back() + contactRows_.back().rowCount());
   }
   // With the reference contact alone the wrench is W0 whatever the formulation (§5).
   bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
@@ -258,7 +260,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
 
   const int outputs = outputs_.size();
   workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()),
-                     ThreadWorkspace(model_, contacts, outputs_.rowsPerContact, closure_ ? closure_->contactCount() : 0,
+                     ThreadWorkspace(model_, contactRowCounts(), closure_ ? closure_->contactCount() : 0,
                                      closing, outputs));
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   for (int s = 0; s < samples_.sampleCount(); ++s) {
@@ -423,16 +425,17 @@ void MotionProblem::buildStructure() {
         sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
                 true);
     if (scenario_.contactConstraints && explicitForces) {
-      const int perContact = outputs_.rowsPerContact;
-      for (int c = 0; c < perContact; ++c)
+      for (int c = 0; c < support_.rowCount(); ++c)
         sampleRow(contactConstraintKind(support_.rowKind(c)), c, false, s, outputs_.referenceRow(c), 1.0, allJoints_, true);
       // An environment contact's rows read its own wrench, in its own frame: only its variables.
       const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
       int firstColumn = 0;
       for (int i = 0; i < contacts; ++i) {
         const int width = 6 * static_cast<int>(forces_->terms(i, s).size());
-        for (int c = 0; c < perContact && width > 0; ++c) {
-          rows_.push_back({contactConstraintKind(support_.rowKind(c)), perContact * (i + 1) + c, s, outputs_.contactRow(i, c)});
+        const ContactAdmissibilityRows& own = contactRows_[static_cast<std::size_t>(i)];
+        for (int c = 0; c < own.rowCount() && width > 0; ++c) {
+          rows_.push_back({contactConstraintKind(own.rowKind(c)), outputs_.contactRowStart[static_cast<std::size_t>(i) + 1] + c, s,
+                           outputs_.contactRow(i, c)});
           for (int l = firstColumn; l < firstColumn + width; ++l)
             entry(b.forceColumns[static_cast<std::size_t>(l)], {Source::Force, false, s, outputs_.contactRow(i, c), l, 1.0});
         }
@@ -483,9 +486,11 @@ std::string MotionProblem::rowSubject(int row) const {
     case ConstraintKind::ContactFriction:
     case ConstraintKind::ContactCop:
     case ConstraintKind::ContactYaw: {
-      const int contact = r.detail / outputs_.rowsPerContact;
+      int contact = 0;  // 0: the reference contact, 1 + i: environment contact i
+      while (r.detail >= outputs_.contactRowStart[static_cast<std::size_t>(contact) + 1]) ++contact;
+      const ContactAdmissibilityRows& rows = contact == 0 ? support_ : contactRows_[static_cast<std::size_t>(contact - 1)];
       name << (contact == 0 ? scenario_.support.name : scenario_.contacts[static_cast<std::size_t>(contact - 1)].surface.name)
-           << " " << support_.rowName(r.detail % outputs_.rowsPerContact);
+           << " " << rows.rowName(r.detail - outputs_.contactRowStart[static_cast<std::size_t>(contact)]);
       break;
     }
     case ConstraintKind::InnerFeasibility: name << "inner problem feasibility (balance slack)"; break;
@@ -553,6 +558,16 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
     for (int l = 0; l < m; ++l)
       if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) lower[j * m + l] = upper[j * m + l] = scenario_.start[j];
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
+  // A contact whose model holds a force alone (the point contact): its moment variables are
+  // fixed at zero.
+  for (int i = 0; forces_ && i < forces_->contactCount(); ++i) {
+    const int size = contactModelOf(contactSpec(scenario_.contacts[static_cast<std::size_t>(i)].surface), scenario_.inner.problem)
+                         .wrenchSize();
+    if (size == 6) continue;
+    for (int s = 0; s < samples_.sampleCount(); ++s)
+      for (const ContactForceParametrization::Term& t : forces_->terms(i, s))
+        lower.segment(t.variable + size, 6 - size).setZero(), upper.segment(t.variable + size, 6 - size).setZero();
+  }
   lower.tail(variableCount_ - slackStart_).setZero();
 }
 
@@ -962,7 +977,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
       wrenchToWorld(frame, toWorld);
       w.torque.noalias() -= toTorque * F;
       reference.noalias() -= toWorld * F;
-      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment(outputs_.contactRow(i, 0), outputs_.rowsPerContact),
+      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment(outputs_.contactRow(i, 0), outputs_.contactRowCount(1 + i)),
                                                         w.rowsByWrench[static_cast<std::size_t>(i)]);
       if (derivatives) {
         wrenchMapDerivatives(model, w.data, frame, F, w.dWorld, w.dTorque);
@@ -970,7 +985,7 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
         w.referenceDq -= w.dWorld;
       }
     }
-    const int perContact = outputs_.rowsPerContact;
+    const int perContact = support_.rowCount();
     ContactRowsByWrench& rowsByReference = w.rowsByReference;
     if (derivatives)
       support_.evaluate(reference, b.y.segment(outputs_.referenceRow(0), perContact), rowsByReference);
@@ -995,7 +1010,8 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
         b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
         b.dyDz.block(outputs_.referenceRow(0), column, perContact, 6).noalias() =
             -t.weight * rowsByReference.lazyProduct(w.toWorld[i_]);
-        b.dyDz.block(outputs_.contactRow(t.contact, 0), column, perContact, 6) = t.weight * w.rowsByWrench[i_];
+        b.dyDz.block(outputs_.contactRow(t.contact, 0), column, outputs_.contactRowCount(1 + t.contact), 6) =
+            t.weight * w.rowsByWrench[i_];
       }
     }
   }

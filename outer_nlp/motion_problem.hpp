@@ -264,11 +264,16 @@ class MotionProblem final : public NlpProblem {
   /// Output index of each per-sample quantity (rows of a sample's evaluation).
   struct SampleOutputs {
     int joints = 0, contacts = 0;  ///< n, environment contacts
-    int rowsPerContact = 6;        ///< the contact model's admissibility rows (contact_admissibility.hpp)
+    /// Admissibility rows (contact_admissibility.hpp): the reference contact's from 0, environment
+    /// contact i's from contactRowStart[1 + i], each as many as its contact model has; contacts + 2 values.
+    std::vector<int> contactRowStart{0, 6};
+    int contactRowCount(int c) const {  ///< c = 0: the reference contact; 1 + i: environment contact i
+      return contactRowStart[static_cast<std::size_t>(c) + 1] - contactRowStart[static_cast<std::size_t>(c)];
+    }
     int torque(int j) const { return j; }
     int referenceRow(int c) const { return joints + c; }
-    int contactRow(int contact, int c) const { return joints + rowsPerContact * (1 + contact) + c; }
-    int infeasibility() const { return joints + rowsPerContact * (1 + contacts); }
+    int contactRow(int contact, int c) const { return joints + contactRowStart[static_cast<std::size_t>(contact) + 1] + c; }
+    int infeasibility() const { return joints + contactRowStart.back(); }
     int power(int j) const { return infeasibility() + 1 + j; }
     int closing = 0;  ///< joints that close an environment contact (closed_chains.hpp)
     int closingPosition(int k) const { return power(joints) + k; }
@@ -306,6 +311,12 @@ class MotionProblem final : public NlpProblem {
     bool startFromSplines = false;
   };
   using ThreadWorkspace = MotionWorkspace;
+  /// The admissibility rows of the reference contact, then of each environment contact.
+  std::vector<int> contactRowCounts() const {
+    std::vector<int> counts;
+    for (int c = 0; c <= outputs_.contacts; ++c) counts.push_back(outputs_.contactRowCount(c));
+    return counts;
+  }
   /// A row of the registry: its kind, what `detail` says (joint, contact row, task
   /// component), the sample / task instant / velocity row it belongs to, and the output it reads.
   struct Row {

@@ -20,15 +20,18 @@ namespace mcopt {
 struct MotionWorkspace {
   /// `held`: contacts held over the whole motion, `closing` their closing joints, `outputs` a
   /// sample's outputs (the chain rule through the closure works on those).
-  MotionWorkspace(const DynamicsModel& model, int contacts, int rowsPerContact, int held = 0, int closing = 0, int outputs = 0)
+  /// `contactRows`: the admissibility rows of the reference contact, then of each environment contact.
+  MotionWorkspace(const DynamicsModel& model, const std::vector<int>& contactRows, int held = 0, int closing = 0,
+                  int outputs = 0)
       : data(model), derivatives(model), task(model), closure(model, held) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
     torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
-    toTorque.assign(static_cast<std::size_t>(contacts), WrenchToTorque::Zero(n, 6));
-    toWorld.assign(static_cast<std::size_t>(contacts), Matrix6::Zero());
-    rowsByWrench.assign(static_cast<std::size_t>(contacts), ContactRowsByWrench::Zero(rowsPerContact, 6));
-    rowsByReference.setZero(rowsPerContact, 6);
+    const std::size_t contacts = contactRows.size() - 1;
+    toTorque.assign(contacts, WrenchToTorque::Zero(n, 6));
+    toWorld.assign(contacts, Matrix6::Zero());
+    for (std::size_t i = 0; i < contacts; ++i) rowsByWrench.emplace_back(ContactRowsByWrench::Zero(contactRows[i + 1], 6));
+    rowsByReference.setZero(contactRows.front(), 6);
     gather.setZero(outputs, 3 * closing), foldQ.setZero(outputs, n), foldV.setZero(outputs, n), foldA.setZero(outputs, n);
     taskGather.setZero(3, 3 * closing), taskFoldQ.setZero(3, n), taskFoldV.setZero(3, n), taskFoldA.setZero(3, n);
   }

@@ -287,7 +287,6 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
                          "a contact's own model takes no parameters: the pyramid is inner.contact_model's, with "
                          "inner.pyramid_facets");
       s.inner.problem.byContact[name] = makeContactModel(modelName);
-      c.modelOrigin = where(file, model, field + ".model");
     }
     c.end = s.duration.initial;
     if (entry.IsMap() && entry["window"]) {
@@ -620,10 +619,6 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     }
   }
   if (contactForces) s.contactForces = *contactForces;
-  for (const EnvironmentContact& c : s.contacts)
-    if (!c.modelOrigin.empty() && s.contactForces != ContactForces::Bilevel)
-      throw InputError(c.modelOrigin + "a contact's own model needs contact_forces: bilevel (the single-level "
-                       "formulations hold one model, inner.contact_model, on every wrench variable)");
   if (root["force_control_points"])
     s.forceControlPoints = integerField(file, root["force_control_points"], "force_control_points", 4);
   if (root["inner"]) readInnerSettings(file, root["inner"], s);

@@ -118,8 +118,6 @@ struct EnvironmentContact {
   bool window = false;
   bool poseGiven = false;
   RigidTransform worldPose;    ///< of the contact frame
-  std::string modelOrigin;     ///< "file:line: contacts[k].model: " when the entry names its own contact model
-                               ///< (held in Scenario::inner.problem.byContact)
 };
 
 struct DurationSpec {

@@ -683,10 +683,6 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"an unknown contact model of its own", [](YAML::Node& r) {
          r["contacts"].push_back(YAML::Load("{surface: r_hand, model: soft}"));
        }, {"contacts[1].model: unknown contact model 'soft'"}},
-      {"a contact model of its own with a single-level formulation", [](YAML::Node& r) {
-         r["contacts"].push_back(YAML::Load("{surface: r_hand, model: point}"));
-         r["contact_forces"] = "splines";
-       }, {"contacts[1].model: a contact's own model needs contact_forces: bilevel"}},
       {"the point model for every contact", [](YAML::Node& r) { r["inner"]["contact_model"] = "point"; },
        {"inner.contact_model: the point model holds a force alone", "contacts[k].model: point"}},
       {"facets without the pyramid", [](YAML::Node& r) { r["inner"]["pyramid_facets"] = 6; },
@@ -861,8 +857,9 @@ TEST_CASE("run: a continuation stage for some formulations runs only with them",
 
 TEST_CASE("run: knuckles on the table as a point contact: a force alone, recorded with its model", "[cli][run][multi-contact]") {
   // The lean reach with its right hand's own contact model (contacts[2].model: point), a few
-  // iterations: the file is read, the hand's moments are zero at every sample, and result.json
-  // names each contact's model. (The full run: docs/tutorials/multi-contact.md.)
+  // iterations of the bilevel and a single-level formulation: the file is read, the hand's
+  // moments are zero at every sample, and result.json names each contact's model. (The full
+  // run: docs/tutorials/multi-contact.md.)
   const test::TempDir dir;
   const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml", dir, [](YAML::Node& root) {
     root["contacts"][2]["model"] = "point";
@@ -870,25 +867,28 @@ TEST_CASE("run: knuckles on the table as a point contact: a force alone, recorde
     root.remove("continuation");
     root["hessian"] = "gauss-newton";
   }, "lean_reach_point.yaml");
-  const auto out = dir.path() / "out";
-  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) + " --max-iterations 3");
-  INFO(r.all());
-  REQUIRE(r.exitCode == 4);
-  const Json result = readJson(out / "result.json");
-  REQUIRE(result["contacts"].size() == 3);
-  CHECK(result["contacts"][0]["contact_model"] == "wrench-cone");
-  CHECK(result["contacts"][1]["contact_model"] == "wrench-cone");
-  CHECK(result["contacts"][2]["contact_model"] == "point");
-  int active = 0;
-  double largest = 0.0;
-  for (const Json& w : result["contacts"][2]["wrench"]) {
-    if (w.is_null()) continue;
-    ++active;
-    for (int k = 3; k < 6; ++k) CHECK(w[static_cast<std::size_t>(k)].get<double>() == 0.0);
-    largest = std::max(largest, w[2].get<double>());
+  for (const char* forces : {"bilevel", "variables"}) {
+    const auto out = dir.path() / forces;
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --contact-forces " + forces + " --out " +
+                                  test::quoted(out) + " --max-iterations 3");
+    INFO(forces << ": " << r.all());
+    REQUIRE(r.exitCode == 4);
+    const Json result = readJson(out / "result.json");
+    REQUIRE(result["contacts"].size() == 3);
+    CHECK(result["contacts"][0]["contact_model"] == "wrench-cone");
+    CHECK(result["contacts"][1]["contact_model"] == "wrench-cone");
+    CHECK(result["contacts"][2]["contact_model"] == "point");
+    int active = 0;
+    double largest = 0.0;
+    for (const Json& w : result["contacts"][2]["wrench"]) {
+      if (w.is_null()) continue;
+      ++active;
+      for (int k = 3; k < 6; ++k) CHECK(w[static_cast<std::size_t>(k)].get<double>() == 0.0);
+      largest = std::max(largest, w[2].get<double>());
+    }
+    CHECK(active > 5);
+    CHECK(largest > 1.0);  // the hand does carry load
   }
-  CHECK(active > 5);
-  CHECK(largest > 1.0);  // the hand does carry load
 }
 
 TEST_CASE("run: multi-contact results, torques reproduced from states and contact wrenches", "[cli][run][multi-contact]") {

@@ -83,34 +83,48 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
 
 TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact derivatives and carries no moment",
           "[outer][multi-contact][contact]") {
-  // The contact model of one contact (contacts[k].model: point): its inner problem has three
-  // variables for the hand, the sensitivity its own layout; the outer gradient and Jacobian
-  // against central differences as for the other formulations' hands above.
-  Scenario s = weightShift(12);
-  s.contactForces = ContactForces::Bilevel;
-  s.fixStart = s.fixEnd = false;
-  addHandContact(s, 0.7, 1.7);
-  s.inner.problem.model = makeContactModel("wrench-cone");
-  s.inner.problem.byContact["r_hand"] = makeContactModel("point");
-  MotionProblem problem(s);
-  Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 7);
-  const test::DerivativeErrors e = test::derivativeErrors(problem, x, 1e-6);
-  INFO("gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern " << e.offPattern
-                   << "; infeasible samples " << problem.infeasibleSamples());
-  CHECK(e.gradient < 1e-6);
-  CHECK(e.jacobian < 1e-6);
-  CHECK(e.offPattern < 1e-6);
-  const SampledPhysics physics = problem.sampledPhysics(x);
-  int handLoaded = 0;
-  for (int k = 0; k < physics.time.size(); ++k) {
-    if (!physics.active[2][static_cast<std::size_t>(k)]) continue;
-    const Eigen::VectorXd hand = physics.wrenches[2].col(k);
-    CHECK(hand.tail<3>().cwiseAbs().maxCoeff() == 0.0);  // no moment: not a variable
-    CHECK(hand.head<2>().norm() <= s.contacts.back().surface.friction * hand[2] + 1e-9);  // its friction cone
-    handLoaded += hand[2] > 1.0;
+  // The contact model of one contact (contacts[k].model: point) in every formulation: bilevel,
+  // its inner problem has three variables for the hand and the sensitivity its own layout; the
+  // single-level formulations hold the hand's moment variables at zero (their bounds) and its
+  // own two rows (f_z, the friction cone). The outer gradient and Jacobian against central
+  // differences as for the other formulations' hands above.
+  for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
+    Scenario s = weightShift(12);
+    s.contactForces = forces;
+    s.fixStart = s.fixEnd = false;
+    addHandContact(s, 0.7, 1.7);
+    s.inner.problem.model = makeContactModel("wrench-cone");
+    s.inner.problem.byContact["r_hand"] = makeContactModel("point");
+    MotionProblem problem(s);
+    Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 7);
+    Eigen::VectorXd lower, upper;
+    problem.variableBounds(lower, upper);
+    x = x.cwiseMax(lower).cwiseMin(upper);
+    const double h = forces == ContactForces::Bilevel ? 1e-6 : 3e-6;  // as in the test above
+    const test::DerivativeErrors e = test::derivativeErrors(problem, x, h);
+    INFO(toString(forces) << ": gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern "
+                          << e.offPattern << "; infeasible samples " << problem.infeasibleSamples());
+    CHECK(e.gradient < 1e-6);
+    CHECK(e.jacobian < 1e-6);
+    CHECK(e.offPattern < 1e-6);
+    int handRows = 0;
+    for (int r = 0; r < problem.constraintCount(); ++r)
+      handRows += problem.rowName(r).rfind("r_hand ", 0) == 0;
+    const SampledPhysics physics = problem.sampledPhysics(x);
+    int active = 0;
+    for (int k = 0; k < physics.time.size(); ++k) {
+      if (!physics.active[2][static_cast<std::size_t>(k)]) continue;
+      ++active;
+      const Eigen::VectorXd hand = physics.wrenches[2].col(k);
+      CHECK(hand.tail<3>().cwiseAbs().maxCoeff() == 0.0);  // no moment
+      if (forces == ContactForces::Bilevel)                 // the inner optimum holds its cone
+        CHECK(hand.head<2>().norm() <= s.contacts.back().surface.friction * hand[2] + 1e-9);
+    }
+    CHECK(active > 0);
+    // Single-level: the hand's rows are its own model's two a sample (f_z, the cone), the
+    // soles' the wrench cone's 17.
+    if (forces != ContactForces::Bilevel) CHECK(handRows == 2 * active);
   }
-  WARN("samples with the point hand loaded: " << handLoaded);
-  CHECK(handLoaded > 0);
 }
 
 TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted and steered by an exact row",
