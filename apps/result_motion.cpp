@@ -96,8 +96,8 @@ Scenario scenarioOfResult(const ResultMotion& result, const std::filesystem::pat
   const ContactForces forces = parseContactForces(result.contactForces);
   Scenario scenario = loadScenario(file, forces);
   ScenarioOverrides overrides;
-  overrides.contactForces = result.contactForces;
-  overrides.innerSolver = result.innerSolver;
+  overrides.contactForces = forces;
+  if (!result.innerSolver.empty()) overrides.innerSolver = result.innerSolver;
   applyOverrides(scenario, overrides);
   // The same robot and the same contacts, in the same order: the motion means nothing otherwise.
   const std::vector<std::string> joints = scenario.robot.jointNames();

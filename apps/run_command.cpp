@@ -38,11 +38,12 @@ extern "C" void requestStop(int) { stopRequested = 1; }
 
 struct RunOptions {
   std::string scenario, out = "mcopt-run";
-  std::string configurationOptimisation;  ///< "", "on" or "off": overrides the scenario
-  std::string contactForces;              ///< "", or a formulation: overrides the scenario
-  int maxIterations = -1;
-  std::string innerSolver;                ///< "", or an inner solver: overrides the scenario
-  std::string hessian;                    ///< "", or a Hessian option: every stage's (ScenarioOverrides)
+  // The command line's text of the overrides (ScenarioOverrides types them): "" when not given.
+  std::string configurationOptimisation;  ///< "on" or "off"
+  std::string contactForces;              ///< a formulation
+  std::optional<int> maxIterations;
+  std::string innerSolver;                ///< an inner solver
+  std::string hessian;                    ///< a Hessian option: every stage's
   double checkpointSeconds = 30.0;  ///< 0: after every iteration; negative: never
   std::string startFrom;            ///< "", or a result folder (or its result.json) to start from
   int refineRounds = -1;            ///< --refine [ROUNDS]; < 0: the scenario's
@@ -91,7 +92,14 @@ int runMotion(const RunOptions& o) {
   std::optional<ContactForces> contactForces;
   if (!o.contactForces.empty()) contactForces = parseContactForces(o.contactForces);
   Scenario scenario = loadScenario(o.scenario, contactForces, o.allowNonPhysicalInertia);
-  applyOverrides(scenario, {o.configurationOptimisation, o.contactForces, o.maxIterations, o.innerSolver, o.hessian, o.refineRounds});
+  ScenarioOverrides overrides;
+  if (!o.configurationOptimisation.empty()) overrides.configurationOptimisation = o.configurationOptimisation == "on";
+  overrides.contactForces = contactForces;
+  overrides.maxIterations = o.maxIterations;
+  if (!o.innerSolver.empty()) overrides.innerSolver = o.innerSolver;
+  if (!o.hessian.empty()) overrides.hessian = parseHessianOption(o.hessian);  // a member of the list: checked by CLI11
+  if (o.refineRounds >= 0) overrides.refineRounds = o.refineRounds;
+  applyOverrides(scenario, overrides);
   if (!o.startFrom.empty()) startFromResult(scenario, o.startFrom);
   for (const std::string& w : scenario.robot.warnings) std::cerr << "mcopt: warning: " << w << "\n";
   for (const std::string& n : urdfFrictionNotes(scenario.actuators, scenario.robot)) std::cerr << "mcopt: note: " << n << "\n";

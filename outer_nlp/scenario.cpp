@@ -407,9 +407,7 @@ const char* toString(HessianOption hessian) {
 HessianOption parseHessianOption(const std::string& name) {
   for (const HessianName& h : kHessianNames)
     if (name == h.name) return h.option;
-  throw InputError(
-      "expected limited-memory, finite-differences, sample-differences, convex-sample-differences, gauss-newton or "
-      "exact, got '" + name + "'");
+  throw InputError("expected " + alternatives(hessianOptionNames()) + ", got '" + name + "'");
 }
 
 const std::vector<std::string>& hessianOptionNames() {

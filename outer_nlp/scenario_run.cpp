@@ -52,13 +52,7 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
 /// `--hessian`: every stage takes the option; a stage that then differs from the next one (or
 /// from the scenario) in nothing but its iteration limit would solve the same problem again,
 /// so it goes and the next one solves it.
-void overrideHessian(Scenario& scenario, const std::string& name) {
-  HessianOption hessian;
-  try {
-    hessian = parseHessianOption(name);
-  } catch (const InputError& e) {
-    throw InputError(std::string("--hessian: ") + e.what());
-  }
+void overrideHessian(Scenario& scenario, HessianOption hessian) {
   scenario.hessian = hessian;
   std::vector<Scenario::ContinuationStage> kept;
   for (std::size_t k = 0; k < scenario.continuation.size(); ++k)
@@ -89,28 +83,28 @@ std::string postureWarning(const std::string& which, const PostureOutcome& p, co
 }  // namespace
 
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
-  if (o.configurationOptimisation == "on")
-    scenario.configurationOptimisation = true;
-  else if (o.configurationOptimisation == "off")
-    scenario.configurationOptimisation = false;
-  else if (!o.configurationOptimisation.empty())
-    throw InputError("configuration_optimisation: expected on or off, got '" + o.configurationOptimisation + "'");
-  if (!o.contactForces.empty()) scenario.contactForces = parseContactForces(o.contactForces);
-  if (o.refineRounds >= 0) scenario.refineRounds = o.refineRounds;
-  if (!o.innerSolver.empty()) {
-    if (!isInnerSolverName(o.innerSolver))
-      throw InputError("inner.solver: unknown inner solver '" + o.innerSolver + "' (expected " + innerSolverList() + ")");
-    scenario.inner.solverName = o.innerSolver;
+  if (o.configurationOptimisation) scenario.configurationOptimisation = *o.configurationOptimisation;
+  if (o.contactForces) scenario.contactForces = *o.contactForces;
+  if (o.refineRounds) {
+    if (*o.refineRounds < 0) throw InputError("refine: expected a number of rounds ≥ 0, got " + std::to_string(*o.refineRounds));
+    scenario.refineRounds = *o.refineRounds;
   }
-  if (!o.hessian.empty()) overrideHessian(scenario, o.hessian);
-  if (o.maxIterations >= 0) {
+  if (o.innerSolver) {
+    if (!isInnerSolverName(*o.innerSolver))
+      throw InputError("inner.solver: unknown inner solver '" + *o.innerSolver + "' (expected " + innerSolverList() + ")");
+    scenario.inner.solverName = *o.innerSolver;
+  }
+  if (o.hessian) overrideHessian(scenario, *o.hessian);
+  if (o.maxIterations) {
+    if (*o.maxIterations < 0)
+      throw InputError("--max-iterations: expected a number ≥ 0, got " + std::to_string(*o.maxIterations));
     SolverOption limit;
-    limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = o.maxIterations;
+    limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = *o.maxIterations;
     limit.origin = "--max-iterations: ";
     scenario.solverOptions.push_back(limit);
     // Every continuation stage too: the override bounds the whole run's work, stage by stage.
     for (Scenario::ContinuationStage& stage : scenario.continuation)
-      stage.maxIterations = stage.maxIterations < 0 ? o.maxIterations : std::min(stage.maxIterations, o.maxIterations);
+      stage.maxIterations = stage.maxIterations < 0 ? *o.maxIterations : std::min(stage.maxIterations, *o.maxIterations);
   }
 }
 

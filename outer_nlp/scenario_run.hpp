@@ -23,21 +23,22 @@
 
 namespace mcopt {
 
-/// Run-time changes to a scenario (`mcopt run` options, keyword arguments in Python).
+/// Run-time changes to a scenario (`mcopt run` options, keyword arguments in Python), typed:
+/// the command line and Python parse their text; an unset field leaves the scenario's.
 struct ScenarioOverrides {
-  std::string configurationOptimisation;  ///< "", "on" or "off"
-  std::string contactForces;              ///< "", or a formulation name (formulation.md §9)
-  int maxIterations = -1;                 ///< Ipopt's max_iter for the motion; < 0: the scenario's
-  std::string innerSolver;                ///< "", or an inner solver name (bilevel, formulation.md §7)
-  /// "", or a Hessian option name: the motion's and every continuation stage's. A stage left
-  /// differing from the scenario in nothing but its iteration limit (a Hessian hand-over, as
-  /// the bundled gauss-newton first stages are) is dropped.
-  std::string hessian;
-  int refineRounds = -1;  ///< `--refine [ROUNDS]`; < 0: the scenario's
+  std::optional<bool> configurationOptimisation;
+  std::optional<ContactForces> contactForces;  ///< formulation.md §9
+  std::optional<int> maxIterations;            ///< Ipopt's max_iter for the motion and the cap of every stage, ≥ 0
+  std::optional<std::string> innerSolver;      ///< a registered inner solver (bilevel, formulation.md §7)
+  /// The motion's and every continuation stage's Hessian. A stage left differing from the
+  /// scenario in nothing but its iteration limit (a Hessian hand-over, as the bundled
+  /// gauss-newton first stages are) is dropped.
+  std::optional<HessianOption> hessian;
+  std::optional<int> refineRounds;  ///< `--refine [ROUNDS]`, ≥ 0
 };
 
-/// Applies the overrides; throws InputError for a value that is not one of the choices, and
-/// "--hessian: exact: …" where the exact Hessian's stencils do not hold (exactHessianRefusal).
+/// Applies the overrides; throws InputError for an unregistered inner solver, a negative count,
+/// and "--hessian: exact: …" where the exact Hessian's stencils do not hold (exactHessianRefusal).
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& overrides);
 
 /// Starts the scenario's motion optimisation from a given motion (a result's: `mcopt run

@@ -141,13 +141,16 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
   const std::optional<ContactForces> forces = formulationArgument(contactForces);
   Scenario scenario = forces && forces != s.contactForces ? loadScenario(s.root, s.file, forces) : s.scenario;
   ScenarioOverrides overrides;
-  if (maxIterations) overrides.maxIterations = *maxIterations;
-  if (contactForces) overrides.contactForces = *contactForces;
-  if (hessian) overrides.hessian = *hessian;
-  if (configurationOptimisation) overrides.configurationOptimisation = *configurationOptimisation ? "on" : "off";
-  if (refine) {
-    if (*refine < 0) throw InputError("refine: expected a number of rounds ≥ 0, got " + std::to_string(*refine));
-    overrides.refineRounds = *refine;
+  overrides.maxIterations = maxIterations;
+  overrides.contactForces = forces;
+  overrides.configurationOptimisation = configurationOptimisation;
+  overrides.refineRounds = refine;
+  if (hessian) {
+    try {
+      overrides.hessian = parseHessianOption(*hessian);
+    } catch (const InputError& e) {
+      throw InputError(std::string("hessian: ") + e.what());
+    }
   }
   applyOverrides(scenario, overrides);
   MotionProblem problem(scenario);

@@ -1027,6 +1027,11 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
   CHECK(refused.exitCode != 0);
   CHECK_THAT(refused.errors, Contains("--inner-solver"));
   CHECK_FALSE(std::filesystem::exists(dir.path() / "no"));
+  // A negative iteration cap is refused, not read as "the scenario's" (it was, silently).
+  const auto negative = test::runMcopt("run " + test::quoted(scenario) + " --max-iterations -1 --out " + test::quoted(dir.path() / "no"));
+  CHECK(negative.exitCode == 2);
+  CHECK_THAT(negative.errors, Contains("--max-iterations: expected a number ≥ 0, got -1"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "no"));
 }
 
 namespace {

@@ -18,7 +18,7 @@ TEST_CASE("InnerNlp: every constraint value is written and matches its Jacobian,
   std::mt19937 rng(2027);
   const auto random = test::randomProblem(rng, 2);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const Eigen::VectorXd F = Eigen::VectorXd::NullaryExpr(12, [&] { return 100.0 * u(rng); });
+  const Eigen::VectorXd wrenches = Eigen::VectorXd::NullaryExpr(12, [&] { return 100.0 * u(rng); });
   const double band = 0.25;
   for (const std::string& model : contactModelNames())
   for (const BalanceMode mode : {BalanceMode::Equality, BalanceMode::Dropped, BalanceMode::Band}) {
@@ -26,6 +26,7 @@ TEST_CASE("InnerNlp: every constraint value is written and matches its Jacobian,
     const ContactProblem problem = test::assemble(random, model);
     const InnerNlp nlp(problem, mode, 1e-3, band);
     const int n = nlp.variableCount(), mi = nlp.inequalityCount(), me = nlp.equalityCount();
+    const Eigen::VectorXd F = wrenches.head(n);  // the model's variables: 12, or 6 for two point contacts
     const double nan = std::numeric_limits<double>::quiet_NaN();
     // Buffers full of NaN: a value left unwritten stays NaN.
     Eigen::VectorXd g = Eigen::VectorXd::Constant(mi, nan), e = Eigen::VectorXd::Constant(std::max(me, 1), nan);

@@ -45,6 +45,8 @@ def test_run_with_refinement_reports_its_rounds():
     kick = mcopt.Scenario(SOURCE / "scenarios" / "hrp2_kick.yaml")
     with pytest.raises(mcopt.InputError, match="refine: expected a number of rounds"):
         kick.run(refine=-1)
+    with pytest.raises(mcopt.InputError, match="max-iterations: expected a number ≥ 0"):
+        kick.run(max_iterations=-1)
     # One iteration: not optimal, so nothing to refine from — round 0 says so, no round follows.
     result = kick.run(max_iterations=1, configuration_optimisation=False, refine=2)
     assert result["status"] != "optimal"
