@@ -25,6 +25,15 @@ void ContactRowWriter::addSupportRows(const ContactSpec& c) {
   add("cop_y_min", K::CenterOfPressure, {{Mx, -1.0}, {Fz, c.yMin}});   // y_min fz ≤ m_x
 }
 
+void AdmissibilityRows::setSmoothFrictionCone(int row, double friction, double weight) {
+  const double scale = 1.0 / (weight * weight);
+  linear.row(row).setZero();
+  offset[row] = 0.0;
+  quadraticRow = row;
+  quadratic.setZero();
+  quadratic.diagonal().head<3>() << -2.0 * scale, -2.0 * scale, 2.0 * friction * friction * scale;
+}
+
 ContactModelRows ContactModel::rows(const ContactSpec& contact) const {
   const int count = rowCount();
   ContactModelRows out;

@@ -66,6 +66,10 @@ struct AdmissibilityRows {
   Eigen::Matrix<double, 6, 6> quadratic = Eigen::Matrix<double, 6, 6>::Zero();
   std::vector<std::string> names;
   std::vector<ContactRowKind> kinds;
+
+  /// Makes `row` the smooth friction cone (μ² f_z² − f_x² − f_y²) / (m g)², scaled to the
+  /// robot's weight m g [N] (the report's and the point contact's outer row).
+  void setSmoothFrictionCone(int row, double friction, double weight);
 };
 
 /// Appends rows a · F ≤ bound over one contact's six wrench components (for a model's rows()).

@@ -24,9 +24,7 @@ class PointContactModel final : public ContactModel {
     out.linear.setZero(2, 6);
     out.offset.setZero(2);
     out.linear(0, ContactRowWriter::Fz) = 1.0;
-    const double scale = 1.0 / (weight * weight);
-    out.quadraticRow = 1;
-    out.quadratic.diagonal().head<3>() << -2.0 * scale, -2.0 * scale, 2.0 * c.friction * c.friction * scale;
+    out.setSmoothFrictionCone(1, c.friction, weight);
     return out;
   }
 

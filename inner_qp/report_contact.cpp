@@ -30,9 +30,7 @@ class ReportContactModel final : public ContactModel {
     out.linear(3, Fz) = c.xMax, out.linear(3, My) = 1.0;
     out.linear(4, Fz) = -c.yMin, out.linear(4, Mx) = 1.0;
     out.linear(5, Fz) = c.yMax, out.linear(5, Mx) = -1.0;
-    const double scale = 1.0 / (weight * weight);
-    out.quadraticRow = 1;
-    out.quadratic.diagonal().head<3>() << -2.0 * scale, -2.0 * scale, 2.0 * c.friction * c.friction * scale;
+    out.setSmoothFrictionCone(1, c.friction, weight);
     return out;
   }
 
