@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "apps/commands.hpp"
+#include "core/errors.hpp"
 #include "apps/json_io.hpp"
 #include "apps/result_motion.hpp"
 #include "apps/run_output.hpp"
@@ -286,8 +287,8 @@ Runner addRun(CLI::App& command) {
                      "on or off: override the scenario's initialisation.configuration_optimisation")
       ->check(CLI::IsMember({"on", "off"}));
   command.add_option("--contact-forces", o->contactForces,
-                     "bilevel, splines or variables: override the scenario's contact_forces (formulation.md §9)")
-      ->check(CLI::IsMember({"bilevel", "splines", "variables"}));
+                     alternatives(contactForcesNames()) + ": override the scenario's contact_forces (formulation.md §9)")
+      ->check(CLI::IsMember(contactForcesNames()));
   command.add_option("--max-iterations", o->maxIterations,
                      "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,

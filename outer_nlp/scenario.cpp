@@ -369,20 +369,35 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
 
 }  // namespace
 
+namespace {
+struct ContactForcesName {
+  ContactForces forces;
+  const char* name;
+};
+constexpr ContactForcesName kContactForcesNames[] = {
+    {ContactForces::Bilevel, "bilevel"}, {ContactForces::Splines, "splines"}, {ContactForces::Variables, "variables"}};
+}  // namespace
+
 const char* toString(ContactForces forces) {
-  switch (forces) {
-    case ContactForces::Bilevel: return "bilevel";
-    case ContactForces::Splines: return "splines";
-    case ContactForces::Variables: return "variables";
-  }
+  for (const ContactForcesName& f : kContactForcesNames)
+    if (f.forces == forces) return f.name;
   return "bilevel";
 }
 
+const std::vector<std::string>& contactForcesNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const ContactForcesName& f : kContactForcesNames) all.emplace_back(f.name);
+    return all;
+  }();
+  return names;
+}
+
 ContactForces parseContactForces(const std::string& name) {
-  if (name == "bilevel") return ContactForces::Bilevel;
-  if (name == "splines") return ContactForces::Splines;
-  if (name == "variables") return ContactForces::Variables;
-  throw InputError("unknown contact-force formulation '" + name + "' (expected bilevel, splines or variables)");
+  for (const ContactForcesName& f : kContactForcesNames)
+    if (name == f.name) return f.forces;
+  throw InputError("unknown contact-force formulation '" + name + "' (expected " + alternatives(contactForcesNames()) +
+                   ")");
 }
 
 namespace {

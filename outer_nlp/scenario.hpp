@@ -76,6 +76,8 @@ enum class ContactForces {
 const char* toString(ContactForces forces);
 /// "bilevel", "splines" or "variables"; throws InputError otherwise (the message lists them).
 ContactForces parseContactForces(const std::string& name);
+/// The formulations' names, in the order documents list them.
+const std::vector<std::string>& contactForcesNames();
 
 /// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/theory/outer-problem.md, "Hessian
 /// and convergence").
