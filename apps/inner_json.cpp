@@ -62,8 +62,7 @@ InnerProblemData readInnerProblem(const std::filesystem::path& file, const Json&
 }
 
 std::shared_ptr<const ContactModel> parseContactModel(const std::string& name, std::optional<int> pyramidFacets) {
-  const auto& names = contactModelNames();
-  if (std::find(names.begin(), names.end(), name) == names.end())
+  if (!isContactModelName(name))
     throw InputError("--contact-model: expected " + contactModelList() + "; got '" + name + "'");
   ContactModelOptions options;
   if (pyramidFacets) {

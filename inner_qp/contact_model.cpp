@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "inner_qp/contact_model.hpp"
 
+#include <algorithm>
+
 #include "core/errors.hpp"
 
 namespace mcopt {
@@ -83,6 +85,11 @@ const std::vector<std::string>& contactModelNames() {
     return out;
   }();
   return names;
+}
+
+bool isContactModelName(const std::string& name) {
+  const auto& names = contactModelNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
 }
 
 std::string contactModelList() { return alternatives(contactModelNames()); }

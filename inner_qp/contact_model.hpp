@@ -136,7 +136,8 @@ struct ContactModelEntry {
 const std::vector<ContactModelEntry>& contactModels();
 /// Their names, in the same order.
 const std::vector<std::string>& contactModelNames();
-/// "report, pyramid or wrench-cone".
+bool isContactModelName(const std::string& name);
+/// "report, pyramid, wrench-cone or point".
 std::string contactModelList();
 /// The model by name; InputError naming the registered ones otherwise.
 std::shared_ptr<const ContactModel> makeContactModel(const std::string& name, const ContactModelOptions& options = {});

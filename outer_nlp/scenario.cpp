@@ -278,8 +278,7 @@ void readContacts(const std::filesystem::path& file, const YAML::Node& list, con
     if (entry.IsMap() && entry["model"]) {
       const YAML::Node model = entry["model"];
       const std::string modelName = yaml::text(file, model, field + ".model");
-      const auto& names = contactModelNames();
-      if (std::find(names.begin(), names.end(), modelName) == names.end())
+      if (!isContactModelName(modelName))
         throw InputError(where(file, model, field + ".model") + "unknown contact model '" + modelName + "' (expected " +
                          contactModelList() + ")");
       if (modelName == "pyramid")
@@ -337,8 +336,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
   std::string modelName = s.inner.problem.model->name();
   if (node["contact_model"]) {
     modelName = yaml::text(file, node["contact_model"], "inner.contact_model");
-    const auto& names = contactModelNames();
-    if (std::find(names.begin(), names.end(), modelName) == names.end())
+    if (!isContactModelName(modelName))
       throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" +
                        modelName + "' (expected " + contactModelList() + ")");
   }
