@@ -21,7 +21,7 @@ struct ReportOptions {
   double timeLimit = 600.0;
 };
 
-int report(const ReportOptions& o) {
+int report([[maybe_unused]] const ReportOptions& o) {  // unused without the benchmarks
 #ifndef MCOPT_BENCH_EXECUTABLE
   throw InputError("mcopt was built without its benchmarks (MCOPT_BUILD_BENCH=OFF): configure with it on for mcopt report");
 #else
