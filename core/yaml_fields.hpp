@@ -70,14 +70,14 @@ inline YAML::Node loadFile(const std::filesystem::path& file) {
 }
 
 inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Node& map, const std::string& field,
-                              std::initializer_list<const char*> allowed) {
+                              const std::vector<std::string>& allowed) {
   if (!map.IsMap()) throw InputError(where(file, map, field) + "expected a mapping");
   for (const auto& entry : map) {
     if (!entry.first.IsScalar()) throw InputError(where(file, entry.first, field) + "a key must be a name, not a list or mapping");
     const std::string key = entry.first.as<std::string>();
     bool known = false;
     std::string list;
-    for (const char* name : allowed) {
+    for (const std::string& name : allowed) {
       known = known || key == name;
       list += std::string(list.empty() ? "" : ", ") + name;
     }
@@ -85,6 +85,10 @@ inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Nod
       throw InputError(where(file, entry.first, field.empty() ? key : field + "." + key) + "unknown key (expected one of " +
                        list + ")");
   }
+}
+inline void rejectUnknownKeys(const std::filesystem::path& file, const YAML::Node& map, const std::string& field,
+                              std::initializer_list<const char*> allowed) {
+  rejectUnknownKeys(file, map, field, std::vector<std::string>(allowed.begin(), allowed.end()));
 }
 
 /// A posture named in a motion or scenario file: `posture: NAME` and optional

@@ -23,18 +23,19 @@ ConfigurationProblem::ConfigurationProblem(const Scenario& scenario, const Dynam
       derivatives_(model),
       taskWorkspace_(model),
       zero_(Eigen::VectorXd::Zero(model.jointCount())),
-      taskDq_(3, model.jointCount()),
-      taskDv_(3, model.jointCount()) {
+      taskValue_(kMaxTaskDimension),
+      taskDq_(kMaxTaskDimension, model.jointCount()),
+      taskDv_(kMaxTaskDimension, model.jointCount()) {
   if (scenario.contactConstraints && !near_) {
     supportRows_ = support.rowCount();
     for (int c = 0; c < support.rowCount(); ++c) rowTask_.push_back(-1), rowComponent_.push_back(c);
   }
   for (std::size_t t = 0; t < scenario.tasks.size(); ++t) {
     const TaskSpec& task = scenario.tasks[t];
-    if (taskReadsVelocity(task.kind)) continue;
+    if (task.task->readsVelocity()) continue;
     if (instant < task.start - 1e-9 || instant > task.end + 1e-9) continue;
     tasks_.push_back(static_cast<int>(t));
-    for (int c = 0; c < 3; ++c)
+    for (int c = 0; c < task.dimension(); ++c)
       if (std::isfinite(task.lower[c]) || std::isfinite(task.upper[c]))
         rowTask_.push_back(static_cast<int>(t)), rowComponent_.push_back(c);
   }
@@ -84,11 +85,11 @@ void ConfigurationProblem::evaluate(const Eigen::VectorXd& q) {
   }
   for (const int t : tasks_) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(t)];
-    Vector3 value;
-    evaluateTask(model_, data_, task, true, taskWorkspace_, value, taskDq_, taskDv_);
-    for (int c = 0; c < 3; ++c)
+    const int d = task.dimension();
+    task.task->calcDiff(model_, data_, taskWorkspace_, taskValue_.head(d), taskDq_.topRows(d), taskDv_.topRows(d));
+    for (int c = 0; c < d; ++c)
       if (std::isfinite(task.lower[c]) || std::isfinite(task.upper[c])) {
-        rows_[row] = value[c];
+        rows_[row] = taskValue_[c];
         rowsByQ_.row(row) = taskDq_.row(c);
         ++row;
       }
@@ -144,7 +145,8 @@ void ConfigurationProblem::jacobianValues(const Eigen::VectorXd& q, Eigen::Vecto
 std::string ConfigurationProblem::rowName(int row) const {
   const int t = rowTask_[static_cast<std::size_t>(row)], c = rowComponent_[static_cast<std::size_t>(row)];
   if (t < 0) return scenario_.support.name + " " + support_.rowName(c);
-  return "task '" + scenario_.tasks[static_cast<std::size_t>(t)].name + "' component " + "xyz"[c];
+  const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(t)];
+  return "task '" + task.name + "' component " + task.task->componentName(c);
 }
 
 }  // namespace mcopt

@@ -25,7 +25,7 @@
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
-#include "outer_nlp/task_kinematics.hpp"
+#include "outer_nlp/task.hpp"
 
 namespace mcopt {
 
@@ -70,7 +70,8 @@ class ConfigurationProblem final : public NlpProblem {
   ContactRowsByWrench rowsByWrench_;
   Eigen::VectorXd zero_, cachedQ_, rows_;
   Eigen::MatrixXd rowsByQ_;
-  Eigen::Matrix3Xd taskDq_, taskDv_;
+  Eigen::VectorXd taskValue_;  ///< kMaxTaskDimension: a task uses its leading rows
+  Eigen::MatrixXd taskDq_, taskDv_;
   bool cacheValid_ = false;
 };
 

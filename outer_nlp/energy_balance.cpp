@@ -36,7 +36,7 @@ Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval) {
     const long release = std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals);
     fine.ball->releaseTime = static_cast<double>(release) / intervals * scenario.duration.initial;
     for (TaskSpec& task : fine.tasks)
-      if (task.kind == TaskKind::ThrowLanding || task.kind == TaskKind::ThrowRelease)
+      if (task.task->reads() == TaskQuantity::Ball)
         task.start = task.end = fine.ball->releaseTime;
   }
   fine.torqueScreening = 0.0;

@@ -23,7 +23,7 @@
 // variable) or a trigonometric polynomial (in a revolute joint's angle), so a stencil of
 // that degree differentiates it exactly (derivative_stencil.hpp); a throw's rows, functions
 // of the ball's state (a square root of it), take the flight's analytic curvature and a
-// stencil of the ball's state alone (task_kinematics.hpp). The duration's row and
+// stencil of the ball's state alone (ball_flight_task.hpp). The duration's row and
 // column follow by the chain rule from z_s = (B0 x, B1 x / T, B2 x / T²) and the objective's
 // weight ∝ T:
 //   ∂²L/∂x∂T = Bᵀ (H_s u + ĝ + c ∇E),  ∂²L/∂T² = uᵀ H_s u + gᵀ z'' + 2 c ∇E·u,
@@ -35,6 +35,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_workspace.hpp"
 #include "outer_nlp/smooth_maximum.hpp"
@@ -239,7 +240,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
 
   // Each row's multiplier on the output it reads (an epigraph row reads −P).
   sampleMultipliers_.setZero(outputs_.size(), N);
-  taskMultipliers_.setZero(3, static_cast<Eigen::Index>(taskBlocks_.size()));
+  taskMultipliers_.setZero(taskRows_, static_cast<Eigen::Index>(taskBlocks_.size()));
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
     const double lambda = multipliers[static_cast<Eigen::Index>(r)];
@@ -277,7 +278,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       l.values.setZero(largestLocal + 1, largestLocal + 1), l.columns.reserve(static_cast<std::size_t>(largestLocal + 1));
     probes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
     taskProbes_.assign(static_cast<std::size_t>(threads), SampleBlock{});
-    for (SampleBlock& p : taskProbes_) p.y.setZero(3), p.dyDq.setZero(3, n), p.dyDv.setZero(3, n);
+    for (SampleBlock& p : taskProbes_) p.y.setZero(taskRows_), p.dyDq.setZero(taskRows_, n), p.dyDv.setZero(taskRows_, n);
     for (SampleBlock& p : probes_) {
       p.y.setZero(outputs), p.wrenches.setZero(6 * (1 + contacts)), p.velocity.setZero(n), p.acceleration.setZero(n);
       p.dyDq.setZero(outputs, n), p.dyDv.setZero(outputs, n), p.dyDa.setZero(outputs, n);
@@ -453,15 +454,15 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
 
 #pragma omp for schedule(static)
     for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
-      const auto lambda = taskMultipliers_.col(i);
+      const TaskSpec& spec = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
+      const Task& task = *spec.task;
+      const auto lambda = taskMultipliers_.col(i).head(spec.dimension());
       LocalHessian& slot = localHessians_[blocks_.size() + static_cast<std::size_t>(i)];
       slot.size = 0;
       if ((lambda.array() == 0.0).all()) continue;  // no bounded component
       const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
       // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
-      const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
-      const TaskKind kind = task.kind;
-      const bool velocity = taskReadsVelocity(kind);
+      const bool velocity = task.readsVelocity();
       const int d = velocity ? 2 * n : n;
       auto base = h.base.head(d), gradient = h.gradient.head(d);
       base.head(n).noalias() = b.dyDq.transpose() * lambda;
@@ -475,11 +476,11 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       }
       const bool durationTerms = exact && freeDuration && velocity;
       // A throw's rows are functions of the ball's state k = (p, v_p): their exact Hessian is the
-      // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (task_kinematics.hpp).
-      const bool throwFlight = exact && (kind == TaskKind::ThrowLanding || kind == TaskKind::ThrowRelease);
-      if (throwFlight) {
+      // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (ball_flight_task.hpp).
+      const BallFlightTask* flight = exact ? task.ballFlight() : nullptr;
+      if (flight) {
         inverseDynamics(model_, w.data, w.q, w.v, w.a);
-        throwFlightCurvature(model_, w.data, task, lambda, w.task, h.ballWeights, h.stateHessian.topLeftCorner(d, d));
+        flight->flightCurvature(model_, w.data, lambda, w.task, h.ballWeights, h.stateHessian.topLeftCorner(d, d));
       }
       if (durationTerms) {  // u = ∂z/∂T = (0, −q̇/T) at the instant, before the probes move q̇
         h.stateByDuration.head(n).setZero();
@@ -495,18 +496,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           column.setZero();
           for (int m = 0; m < stencil.size(); ++m) {
             component = saved + stencil.offsets[static_cast<std::size_t>(m)];
-            if (throwFlight) {
+            if (flight) {
               inverseDynamics(model_, w.data, w.q, w.v, w.a);
-              ballStateGradient(model_, w.data, task, h.ballWeights, w.task, gradient.head(n), gradient.tail(n));
+              flight->ballStateGradient(model_, w.data, h.ballWeights, w.task, gradient.head(n), gradient.tail(n));
             } else {
               taskOutputs(i, true, w, taskProbe);
-              gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
-              if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+              gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
+              if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
             }
             column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
           }
           component = saved;
-          if (throwFlight)
+          if (flight)
             h.stateHessian.col(c).head(d) += column;
           else
             h.stateHessian.col(c).head(d) = column;

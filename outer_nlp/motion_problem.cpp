@@ -18,6 +18,7 @@
 #include "core/no_malloc_scope.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/ballistic_flight.hpp"
 #include "outer_nlp/motion_workspace.hpp"
 #include "outer_nlp/smooth_maximum.hpp"
@@ -259,9 +260,11 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   }
 
   const int outputs = outputs_.size();
+  // The task buffers' rows: the largest task dimension (3 unless every task has fewer, or one more).
+  for (const int t : taskOfInstant_) taskRows_ = std::max(taskRows_, scenario_.tasks[static_cast<std::size_t>(t)].dimension());
   workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()),
                      ThreadWorkspace(model_, contactRowCounts(), closure_ ? closure_->contactCount() : 0,
-                                     closing, outputs));
+                                     closing, outputs, taskRows_));
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   for (int s = 0; s < samples_.sampleCount(); ++s) {
     SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
@@ -286,8 +289,9 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   taskBlocks_.resize(taskOfInstant_.size());
   for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
     SampleBlock& b = taskBlocks_[i];
-    b.y.setZero(3), b.dyDT.setZero(3);
-    b.dyDq.setZero(3, jointCount_), b.dyDv.setZero(3, jointCount_), b.dyDa.setZero(3, jointCount_);
+    const int d = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])].dimension();
+    b.y.setZero(d), b.dyDT.setZero(d);
+    b.dyDq.setZero(d, jointCount_), b.dyDv.setZero(d, jointCount_), b.dyDa.setZero(d, jointCount_);
     b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     // At a window's end the task reads the splines' state: there they meet the closure.
@@ -309,13 +313,13 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   }
   for (const int t : taskOfInstant_) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(t)];
-    if (task.kind == TaskKind::CenterOfMass || closure_) {
+    if (task.task->frame() < 0 || closure_) {
       taskJoints_.push_back(allJoints_);
       continue;
     }
     std::vector<int> path;
     for (int j = 0; j < jointCount_; ++j)
-      if (model_.supports(j, model_.framePosition(task.frame))) path.push_back(j);
+      if (model_.supports(j, model_.framePosition(task.task->frame()))) path.push_back(j);
     taskJoints_.push_back(path);
   }
   // A spline parameter is used when it reaches a sample or task instant where its joint is a
@@ -462,7 +466,7 @@ void MotionProblem::buildStructure() {
   }
   for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
     const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])];
-    for (int c = 0; c < 3; ++c) {
+    for (int c = 0; c < task.dimension(); ++c) {
       if (!std::isfinite(task.lower[c]) && !std::isfinite(task.upper[c])) continue;
       sampleRow(task.closure ? ConstraintKind::Closure : ConstraintKind::Task, c, true, static_cast<int>(i), c, 1.0,
                 taskJoints_[i], false);
@@ -507,7 +511,7 @@ std::string MotionProblem::rowSubject(int row) const {
     case ConstraintKind::Closure:
     case ConstraintKind::Task: {
       const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(r.block)])];
-      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << "xyz"[r.detail];
+      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << task.task->componentName(r.detail);
       break;
     }
   }
@@ -822,8 +826,8 @@ void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool de
   closure_->readAngles(w.q, b.closed, b.closedAngles);
 }
 
-void MotionProblem::foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
-                                Eigen::MatrixXd& da) const {
+void MotionProblem::foldClosure(const SampleBlock& b, Eigen::Ref<Eigen::MatrixXd> gather, Eigen::Ref<Eigen::MatrixXd> dq,
+                                Eigen::Ref<Eigen::MatrixXd> dv, Eigen::Ref<Eigen::MatrixXd> da) const {
   // ∂y/∂x_F = ∂y/∂x_F|_C fixed + ∂y/∂x_C M, x = (q, q̇, q̈); the closing joints' own columns then read zero.
   const int c = outputs_.closing, n = jointCount_;
   const std::vector<int>& closing = closure_->closingJoints();
@@ -1055,8 +1059,9 @@ void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, Threa
   if (!derivatives) return;
   if (closure_) {
     // Tasks read q and q̇; the closure's q_C and q̇_C depend on no q̈.
-    foldClosure(b, w.taskGather, w.taskFoldQ, w.taskFoldV, w.taskFoldA);
-    taskSamples_.chainRule(i, T, w.taskFoldQ, w.taskFoldV, Eigen::MatrixXd(), b.dyDx, b.parameters);
+    const Eigen::Index d = b.y.size();
+    foldClosure(b, w.taskGather.topRows(d), w.taskFoldQ.topRows(d), w.taskFoldV.topRows(d), w.taskFoldA.topRows(d));
+    taskSamples_.chainRule(i, T, w.taskFoldQ.topRows(d), w.taskFoldV.topRows(d), Eigen::MatrixXd(), b.dyDx, b.parameters);
   } else {
     taskSamples_.chainRule(i, T, b.dyDq, b.dyDv, Eigen::MatrixXd(), b.dyDx, b.parameters);
   }
@@ -1064,11 +1069,13 @@ void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, Threa
 }
 
 void MotionProblem::taskOutputs(int i, bool derivatives, ThreadWorkspace& w, SampleBlock& b) {
-  const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
+  const Task& task = *scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])].task;
+  const int d = task.dimension();  // b's leading rows: a probe has taskRows_
   inverseDynamics(model_, w.data, w.q, w.v, w.a);
-  Vector3 value;
-  evaluateTask(model_, w.data, task, derivatives, w.task, value, b.dyDq, b.dyDv);
-  b.y = value;
+  if (derivatives)
+    task.calcDiff(model_, w.data, w.task, b.y.head(d), b.dyDq.topRows(d), b.dyDv.topRows(d));
+  else
+    task.calc(model_, w.data, w.task, b.y.head(d));
 }
 
 void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
@@ -1246,8 +1253,9 @@ MotionProblem::Violations MotionProblem::violations(const Eigen::VectorXd& x) {
 std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) const {
   if (!scenario_.ball) return std::nullopt;
   const ThrownBall& ball = *scenario_.ball;
-  const auto landing = std::find_if(scenario_.tasks.begin(), scenario_.tasks.end(),
-                                    [](const TaskSpec& t) { return t.kind == TaskKind::ThrowLanding; });
+  const auto landing = std::find_if(scenario_.tasks.begin(), scenario_.tasks.end(), [](const TaskSpec& t) {
+    return t.task->ballFlight() && t.task->ballFlight()->part() == BallFlightTask::Part::Landing;
+  });
   const double T = duration(x);
   const SampledTrajectory atRelease(parametrization_, std::vector<double>{sampleTimes_[static_cast<std::size_t>(releaseSample_)]});
   Eigen::MatrixXd controlPoints;
@@ -1268,14 +1276,14 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   r.time = atRelease.time(0, T);
   r.position = pose.rotation * ball.point + pose.translation;
   r.velocity = data.linearVelocity[body] + data.angularVelocity[body].cross(r.position);
-  const BallisticFlight f = ballisticFlight(r.position, r.velocity, landing->target.z(), landing->gravity);
+  const BallisticFlight f = ballisticFlight(r.position, r.velocity, ball.target.z(), ball.gravity);
   r.flightTime = f.flightTime;
-  r.landing = Vector3(f.landing.x(), f.landing.y(), landing->target.z());
+  r.landing = Vector3(f.landing.x(), f.landing.y(), ball.target.z());
   r.apexAboveTarget = f.apexAboveTarget;
   r.speed = f.speed, r.elevation = f.elevation;
-  r.target = landing->target;
+  r.target = ball.target;
   r.targetHalfWidths = landing->upper.head<2>();
-  const Eigen::Vector2d offset = f.landing - landing->target.head<2>();
+  const Eigen::Vector2d offset = f.landing - ball.target.head<2>();
   r.missDistance = offset.norm();
   r.missOutsideBox = (offset.cwiseAbs() - landing->upper.head<2>()).cwiseMax(0.0).norm();
   return r;

@@ -63,7 +63,7 @@
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
-#include "outer_nlp/task_kinematics.hpp"
+#include "outer_nlp/task.hpp"
 
 namespace mcopt {
 
@@ -358,8 +358,9 @@ class MotionProblem final : public NlpProblem {
   void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives);
   /// Chain rule through the closure: (dyDq, dyDv, dyDa) of b, the closing joints' columns
   /// folded into the others' through b.closureMap, into dq, dv, da.
-  void foldClosure(const SampleBlock& b, Eigen::MatrixXd& gather, Eigen::MatrixXd& dq, Eigen::MatrixXd& dv,
-                   Eigen::MatrixXd& da) const;
+  /// (All four of b's output rows: a task instant passes its workspace's top rows.)
+  void foldClosure(const SampleBlock& b, Eigen::Ref<Eigen::MatrixXd> gather, Eigen::Ref<Eigen::MatrixXd> dq,
+                   Eigen::Ref<Eigen::MatrixXd> dv, Eigen::Ref<Eigen::MatrixXd> da) const;
   /// A gradient in the full state's first `stateBlocks` blocks (q; q, q̇; or q, q̇, q̈), brought
   /// to the spline joints' through the closure's map: g_F += Mᵀ g_C, g_C = 0.
   void foldGradient(const Eigen::MatrixXd& map, ClosureSet closed, int stateBlocks, Eigen::Ref<Eigen::VectorXd> gradient) const;
@@ -378,7 +379,7 @@ class MotionProblem final : public NlpProblem {
     // the state and force columns at the sample's point, and C J_W for the rows' curvature.
     Vector6 wrenchWeights = Vector6::Zero();
     Eigen::Matrix<double, 6, Eigen::Dynamic> wrenchJacobian, curvedWrenchJacobian;
-    // A throw's task instant: the weights its flight puts on the ball's state (task_kinematics.hpp).
+    // A throw's task instant: the weights its flight puts on the ball's state (ball_flight_task.hpp).
     Vector6 ballWeights = Vector6::Zero();
     // Closed chains: the closing joints' columns and rows of H set aside while the state Hessian
     // is brought to the spline joints' (motion_hessian.cpp).
@@ -473,6 +474,7 @@ class MotionProblem final : public NlpProblem {
   Eigen::MatrixXd hessianSum_;
   std::vector<SampleBlock> probes_, taskProbes_;  ///< per thread: outputs at a perturbed state
   Eigen::MatrixXd sampleMultipliers_, taskMultipliers_;  ///< per output × sample / task instant
+  int taskRows_ = 1;  ///< the largest task dimension: rows of the task multipliers, probes and fold buffers
   Eigen::MatrixXd controlPoints_;
   Eigen::VectorXd cachedX_;
   bool cachedDerivatives_ = false, cacheValid_ = false;

@@ -12,7 +12,7 @@
 #include "core/spatial.hpp"
 #include "outer_nlp/closed_chains.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
-#include "outer_nlp/task_kinematics.hpp"
+#include "outer_nlp/task.hpp"
 
 namespace mcopt {
 
@@ -21,8 +21,9 @@ struct MotionWorkspace {
   /// `held`: contacts held over the whole motion, `closing` their closing joints, `outputs` a
   /// sample's outputs (the chain rule through the closure works on those).
   /// `contactRows`: the admissibility rows of the reference contact, then of each environment contact.
+  /// `taskRows`: the largest task dimension (the task instants' buffers' rows).
   MotionWorkspace(const DynamicsModel& model, const std::vector<int>& contactRows, int held = 0, int closing = 0,
-                  int outputs = 0)
+                  int outputs = 0, int taskRows = kMaxTaskDimension)
       : data(model), derivatives(model), task(model), closure(model, held) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
@@ -33,7 +34,8 @@ struct MotionWorkspace {
     for (std::size_t i = 0; i < contacts; ++i) rowsByWrench.emplace_back(ContactRowsByWrench::Zero(contactRows[i + 1], 6));
     rowsByReference.setZero(contactRows.front(), 6);
     gather.setZero(outputs, 3 * closing), foldQ.setZero(outputs, n), foldV.setZero(outputs, n), foldA.setZero(outputs, n);
-    taskGather.setZero(3, 3 * closing), taskFoldQ.setZero(3, n), taskFoldV.setZero(3, n), taskFoldA.setZero(3, n);
+    taskGather.setZero(taskRows, 3 * closing), taskFoldQ.setZero(taskRows, n), taskFoldV.setZero(taskRows, n),
+        taskFoldA.setZero(taskRows, n);
   }
   DynamicsData data;
   DynamicsDerivatives derivatives;

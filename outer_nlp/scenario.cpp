@@ -50,54 +50,84 @@ Eigen::VectorXd readPosture(const std::filesystem::path& file, const YAML::Node&
   return yaml::postureWithOffsets(file, node, field, robot, postures);
 }
 
-/// Three bounds, each a number or null (free).
-Eigen::Vector3d boundList(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
-                          double freeValue) {
-  if (!node.IsSequence() || node.size() != 3)
-    throw InputError(where(file, node, field) + "expected a list of 3 numbers (null for a free component)");
-  Eigen::Vector3d v;
-  for (std::size_t i = 0; i < 3; ++i)
-    v[static_cast<Eigen::Index>(i)] =
-        node[i].IsNull() ? freeValue : yaml::number(file, node[i], field + "[" + std::to_string(i) + "]");
-  return v;
-}
+/// A task entry of the `tasks` list as its kind's reader sees it (task.hpp).
+class YamlTaskFields final : public TaskFields {
+ public:
+  YamlTaskFields(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
+                 const RobotModel& robot, bool window)
+      : file_(file), node_(node), field_(field), robot_(robot), window_(window) {}
+  bool has(const std::string& key) const override { return static_cast<bool>(node_[key]); }
+  double number(const std::string& key) const override { return yaml::number(file_, at(key), name(key)); }
+  std::vector<double> numbers(const std::string& key, int count) const override {
+    return yaml::numbers(file_, at(key), name(key), static_cast<std::size_t>(count));
+  }
+  std::vector<double> bounds(const std::string& key, int count, double freeValue) const override {
+    const YAML::Node node = at(key);
+    if (!node.IsSequence() || node.size() != static_cast<std::size_t>(count))
+      throw InputError(where(file_, node, name(key)) + "expected a list of " + std::to_string(count) +
+                       " numbers (null for a free component)");
+    std::vector<double> v(static_cast<std::size_t>(count));
+    for (std::size_t i = 0; i < v.size(); ++i)
+      v[i] = node[i].IsNull() ? freeValue : yaml::number(file_, node[i], name(key) + "[" + std::to_string(i) + "]");
+    return v;
+  }
+  int body(const std::string& key) const override {
+    const YAML::Node node = at(key);
+    const std::string body = yaml::text(file_, node, name(key));
+    const int frame = robot_.findFrame(body);
+    if (frame < 0)
+      throw InputError(where(file_, node, name(key)) + "unknown body '" + body + "' " + robot_.unknownFrameHint(body));
+    return frame;
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const override {
+    const YAML::Node node = node_[key];
+    throw InputError(where(file_, node ? node : node_, name(key)) + message);
+  }
+  bool window() const override { return window_; }
 
+ private:
+  std::string name(const std::string& key) const { return field_ + "." + key; }
+  YAML::Node at(const std::string& key) const {
+    if (!node_[key]) fail(key, "missing required field");
+    return node_[key];
+  }
+  const std::filesystem::path& file_;
+  const YAML::Node& node_;
+  const std::string& field_;
+  const RobotModel& robot_;
+  bool window_;
+};
+
+/// A task of the `tasks` list (not a throw): its name, kind and instant or window here, the
+/// rest from its kind's reader (task.hpp's registry).
 TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field,
                   const RobotModel& robot, double duration) {
-  yaml::rejectUnknownKeys(file, node, field,
-                          {"name", "kind", "body", "point", "time", "window", "target", "tolerance", "lower", "upper"});
   TaskSpec t;
   t.origin = where(file, node, field);
   t.origin.resize(t.origin.size() - 2);  // without the trailing ": "
-  t.name = node["name"] ? yaml::text(file, node["name"], field + ".name") : field;
   const YAML::Node kindNode = yaml::required(file, node, "kind", field);
   const std::string kind = yaml::text(file, kindNode, field + ".kind");
-  static const std::map<std::string, TaskKind> kinds = {{"position", TaskKind::Position},
-                                                        {"orientation", TaskKind::Orientation},
-                                                        {"linear_velocity", TaskKind::LinearVelocity},
-                                                        {"angular_velocity", TaskKind::AngularVelocity},
-                                                        {"center_of_mass", TaskKind::CenterOfMass}};
-  const auto k = kinds.find(kind);
-  if (k == kinds.end())
-    throw InputError(where(file, kindNode, field + ".kind") + "unknown task kind '" + kind +
-                     "' (expected position, orientation, linear_velocity, angular_velocity, center_of_mass, throw)");
-  t.kind = k->second;
-
-  if (t.kind == TaskKind::CenterOfMass) {
-    if (node["body"]) throw InputError(where(file, node["body"], field + ".body") + "a centre-of-mass task has no body");
-  } else {
-    const YAML::Node bodyNode = yaml::required(file, node, "body", field);
-    t.body = yaml::text(file, bodyNode, field + ".body");
-    t.frame = robot.findFrame(t.body);
-    if (t.frame < 0)
-      throw InputError(where(file, bodyNode, field + ".body") + "unknown body '" + t.body + "' " + robot.unknownFrameHint(t.body));
+  const TaskKindEntry* entry = findTaskKind(kind);
+  if (!entry)
+    throw InputError(where(file, kindNode, field + ".kind") + "unknown task kind '" + kind + "' (expected " +
+                     taskKindList() + ")");
+  // A field another kind takes is named as such; any other is unknown.
+  std::vector<std::string> keys{"name", "kind", "time", "window"}, everyKey = keys;
+  keys.insert(keys.end(), entry->keys.begin(), entry->keys.end());
+  for (const TaskKindEntry& e : taskKinds())
+    for (const std::string& key : e.keys)
+      if (std::find(everyKey.begin(), everyKey.end(), key) == everyKey.end()) everyKey.push_back(key);
+  yaml::rejectUnknownKeys(file, node, field, everyKey);
+  for (const auto& item : node) {
+    const std::string key = item.first.as<std::string>();
+    if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+      std::string takes;
+      for (std::size_t i = 4; i < keys.size(); ++i) takes += (i > 4 ? ", " : "") + keys[i];
+      throw InputError(where(file, item.first, field + "." + key) + "'" + key + "' is not a field of " + kind +
+                       " tasks (they take " + (takes.empty() ? "none" : takes) + ")");
+    }
   }
-  if (node["point"]) {
-    if (t.kind != TaskKind::Position && t.kind != TaskKind::LinearVelocity)
-      throw InputError(where(file, node["point"], field + ".point") + "only position and linear_velocity tasks take a point");
-    const auto p = yaml::numbers(file, node["point"], field + ".point", 3);
-    t.point = Vector3(p[0], p[1], p[2]);
-  }
+  t.name = node["name"] ? yaml::text(file, node["name"], field + ".name") : field;
 
   if (node["time"] && node["window"])
     throw InputError(where(file, node["window"], field + ".window") + "give either time or window, not both");
@@ -115,35 +145,12 @@ TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, con
   } else {
     throw InputError(where(file, node, field + ".time") + "missing required field (time or window)");
   }
-  if ((t.kind == TaskKind::LinearVelocity || t.kind == TaskKind::AngularVelocity) && t.window)
-    throw InputError(where(file, node["window"], field + ".window") + "velocity tasks hold at an instant (use time)");
 
-  const bool hasTarget = static_cast<bool>(node["target"]);
-  if (hasTarget && (node["lower"] || node["upper"]))
-    throw InputError(where(file, node["target"], field + ".target") + "give either target (and tolerance) or lower/upper");
-  if (t.kind == TaskKind::Orientation) {
-    // The error vector ½ vee(Rtᵀ R − Rᵀ Rt) is sin θ times the axis: bounded by the tolerance.
-    if (!hasTarget) throw InputError(where(file, node, field + ".target") + "missing required field (rpy of the target)");
-    const auto r = yaml::numbers(file, node["target"], field + ".target", 3);
-    t.targetRotation = rotationFromRpy(r[0], r[1], r[2]);
-    const double tol = node["tolerance"] ? yaml::nonNegative(file, node["tolerance"], field + ".tolerance") : 0.0;
-    t.lower.setConstant(-tol), t.upper.setConstant(tol);
-    return t;
-  }
-  if (hasTarget) {
-    const Eigen::Vector3d target = boundList(file, node["target"], field + ".target", kInf);
-    const double tol = node["tolerance"] ? yaml::nonNegative(file, node["tolerance"], field + ".tolerance") : 0.0;
-    for (int i = 0; i < 3; ++i)
-      if (std::isfinite(target[i])) t.lower[i] = target[i] - tol, t.upper[i] = target[i] + tol;
-  } else {
-    if (node["tolerance"])
-      throw InputError(where(file, node["tolerance"], field + ".tolerance") + "a tolerance goes with a target");
-    if (node["lower"]) t.lower = boundList(file, node["lower"], field + ".lower", -kInf);
-    if (node["upper"]) t.upper = boundList(file, node["upper"], field + ".upper", kInf);
-    for (int i = 0; i < 3; ++i)
-      if (t.lower[i] > t.upper[i])
-        throw InputError(where(file, node["upper"], field + ".upper") + "upper bound below lower bound");
-  }
+  const ReadTask read = entry->read(YamlTaskFields(file, node, field, robot, t.window));
+  t.task = read.task;
+  t.lower = read.lower, t.upper = read.upper;
+  if (t.lower.size() != t.dimension() || t.upper.size() != t.dimension())
+    throw std::logic_error("task kind '" + kind + "': its reader gave bounds of the wrong size");
   if (!(t.lower.array() > -kInf).any() && !(t.upper.array() < kInf).any())
     throw InputError(t.origin + ": " + field + ": the task bounds nothing (give target, lower or upper)");
   return t;
@@ -192,25 +199,21 @@ RigidTransform contactPoseAt(const Scenario& s, const ContactSurface& surface, c
 /// window inside the motion, where the splines meet the closure, four tasks of equality: the
 /// frame at its pose and at rest (the motion C¹ there: its accelerations jump with the wrench).
 void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
+  const int frame = c.surface.frame;
   TaskSpec position;
   position.name = "closure of " + c.surface.name + " (position)";
   position.origin = c.origin;
   position.closure = true;
   position.heldByConstruction = true;
-  position.kind = TaskKind::Position;
-  position.body = s.robot.frames[static_cast<std::size_t>(c.surface.frame)].name;
-  position.frame = c.surface.frame;
-  position.point = c.surface.placement.translation;
+  position.task = makePositionTask(frame, c.surface.placement.translation);
   position.start = c.start, position.end = c.end, position.window = c.end > c.start;
   position.lower = c.worldPose.translation.array() - s.closurePositionTolerance;
   position.upper = c.worldPose.translation.array() + s.closurePositionTolerance;
   TaskSpec orientation = position;
   orientation.name = "closure of " + c.surface.name + " (orientation)";
-  orientation.kind = TaskKind::Orientation;
-  orientation.point = Vector3::Zero();
-  orientation.targetRotation = c.worldPose.rotation * c.surface.placement.rotation.transpose();
-  orientation.lower.setConstant(-s.closureOrientationTolerance);
-  orientation.upper.setConstant(s.closureOrientationTolerance);
+  orientation.task = makeOrientationTask(frame, c.worldPose.rotation * c.surface.placement.rotation.transpose());
+  orientation.lower.setConstant(3, -s.closureOrientationTolerance);
+  orientation.upper.setConstant(3, s.closureOrientationTolerance);
   s.tasks.push_back(position);
   s.tasks.push_back(orientation);
   if (!c.window) return;
@@ -226,14 +229,13 @@ void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
     o.heldByConstruction = false;
     o.start = o.end = end, o.window = false;
     o.name = "closure of " + c.surface.name + at + " (orientation)";
-    o.lower.setZero(), o.upper.setZero();
+    o.lower.setZero(3), o.upper.setZero(3);
     v.name = "closure of " + c.surface.name + at + " (velocity)";
-    v.kind = TaskKind::LinearVelocity;
-    v.lower.setZero(), v.upper.setZero();
+    v.task = makeLinearVelocityTask(frame, c.surface.placement.translation);
+    v.lower.setZero(3), v.upper.setZero(3);
     w.name = "closure of " + c.surface.name + at + " (angular velocity)";
-    w.kind = TaskKind::AngularVelocity;
-    w.point = Vector3::Zero();
-    w.lower.setZero(), w.upper.setZero();
+    w.task = makeAngularVelocityTask(frame);
+    w.lower.setZero(3), w.upper.setZero(3);
     for (const TaskSpec* t : {&p, &o, &v, &w}) s.tasks.push_back(*t);
   }
 }

@@ -10,6 +10,7 @@
 #include <array>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "core/robot_files.hpp"
 #include "core/robot_model.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
+#include "outer_nlp/task.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt {
@@ -27,33 +29,21 @@ enum class EnergyForm {
   Epigraph,       ///< slack s ≥ P, s ≥ 0 per joint and sample; minimise the trapezoid sum of s
 };
 
-/// ThrowLanding and ThrowRelease are the two halves of a `throw` task (formulation.md §10;
-/// outer_nlp/ballistic_flight.hpp), both at the release instant on the ball's point:
-///   ThrowLanding  (L_x − target_x, L_y − target_y, τ): the landing point at the target's
-///                 height relative to the target, and the flight time;
-///   ThrowRelease  (|v|, elevation of v [rad], apex height above the target [m]).
-enum class TaskKind { Position, Orientation, LinearVelocity, AngularVelocity, CenterOfMass, ThrowLanding, ThrowRelease };
-
-/// Bounds on a 3-vector task quantity; ±∞ where a component is free.
+/// A task of the scenario: what it bounds (a Task, outer_nlp/task.hpp), where it came from,
+/// when it holds, and its bounds; ±∞ where a component is free.
 struct TaskSpec {
   std::string name;          ///< from the file, or "tasks[i]"
   std::string origin;        ///< "file:line" of the task, for messages
-  TaskKind kind = TaskKind::Position;
+  std::shared_ptr<const Task> task;
   bool closure = false;      ///< made by a contact: its frame holds its world pose (formulation.md §10)
   /// A contact's closure over its window: the motion problem holds it exactly by construction
   /// (closed_chains.hpp) and has no rows for it; the configuration problem keeps it, within
   /// `closure_tolerance`, for the postures inside the window.
   bool heldByConstruction = false;
-  std::string body;          ///< URDF link (empty for the centre of mass)
-  int frame = -1;            ///< RobotModel frame of `body`
-  Vector3 point = Vector3::Zero();       ///< in the body frame (position, linear velocity)
-  Matrix3 targetRotation = Matrix3::Identity();  ///< orientation tasks: the error is measured from it
-  Vector3 target = Vector3::Zero();      ///< throw tasks: the target point, world frame [m]
-  double gravity = 9.81;                 ///< throw tasks: gravity's magnitude (along −z) [m/s²]
   double start = 0.0, end = 0.0;         ///< instant (start == end) or window [s], of the initial duration
   bool window = false;
-  Eigen::Vector3d lower = Eigen::Vector3d::Constant(-std::numeric_limits<double>::infinity());
-  Eigen::Vector3d upper = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  TaskVector lower, upper;               ///< task->dimension() entries each
+  int dimension() const { return task->dimension(); }
 };
 
 /// The ball of a `throw` task (formulation.md §10): a point mass carried by a body until its
@@ -65,6 +55,8 @@ struct ThrownBall {
   Vector3 point = Vector3::Zero();  ///< the ball's centre in that frame [m]
   double mass = 0.0;           ///< [kg]
   double releaseTime = 0.0;    ///< t_r [s] of the initial duration; a sample (a fraction of a free duration)
+  Vector3 target = Vector3::Zero();  ///< the throw's target point, world frame [m]
+  double gravity = 9.81;             ///< gravity's magnitude (along −z) [m/s²]
 };
 
 /// How the contact wrenches enter the outer problem (formulation.md §9).

@@ -16,7 +16,7 @@
 namespace mcopt {
 
 /// The `throw` task (formulation.md §10; docs/reference/scenario-file.md, "Throw"; outer_nlp/throw_task.cpp):
-/// `node` is tasks[i] with `kind: throw`; appends its two rows (TaskKind::ThrowLanding,
+/// `node` is tasks[i] with `kind: throw`; appends its two rows (BallFlightTask landing and
 /// ThrowRelease) to s.tasks and sets s.ball. Needs the robot, the duration and the gravity read.
 void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, Scenario& s);
 /// What only the whole scenario decides: the release on a sample of the motion (and of every

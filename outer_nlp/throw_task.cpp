@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
+#include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
 namespace mcopt {
@@ -62,16 +63,18 @@ void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, co
   if (s.gravity.head<2>().norm() > 1e-12 * s.gravity.norm() || !(s.gravity.z() < 0.0))
     throw InputError(where(file, node, field) + "a throw needs gravity along −z (gravity: [0, 0, −g])");
 
+  const YAML::Node targetNode = yaml::required(file, node, "target", field);
+  const auto target = yaml::numbers(file, targetNode, field + ".target", 3);
+  ball.target = Vector3(target[0], target[1], target[2]);
+  ball.gravity = -s.gravity.z();
+
   TaskSpec landing;
   landing.name = node["name"] ? yaml::text(file, node["name"], field + ".name") : field;
   landing.origin = ball.origin;
-  landing.kind = TaskKind::ThrowLanding;
-  landing.body = ball.body, landing.frame = ball.frame, landing.point = ball.point;
+  landing.task = std::make_shared<BallFlightTask>(BallFlightTask::Part::Landing, ball.frame, ball.point, ball.target,
+                                                  ball.gravity);
   landing.start = landing.end = ball.releaseTime;
-  landing.gravity = -s.gravity.z();
-  const YAML::Node targetNode = yaml::required(file, node, "target", field);
-  const auto target = yaml::numbers(file, targetNode, field + ".target", 3);
-  landing.target = Vector3(target[0], target[1], target[2]);
+  landing.lower.setConstant(3, -kInf), landing.upper.setConstant(3, kInf);
   // A point target, or a box: half-widths in x and y of the landing point at the target's height.
   Eigen::Vector2d tolerance = Eigen::Vector2d::Zero();
   if (const YAML::Node t = node["tolerance"]) {
@@ -93,8 +96,9 @@ void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, co
   }
 
   TaskSpec release = landing;
-  release.kind = TaskKind::ThrowRelease;
-  release.lower.setConstant(-kInf), release.upper.setConstant(kInf);
+  release.task = std::make_shared<BallFlightTask>(BallFlightTask::Part::Release, ball.frame, ball.point, ball.target,
+                                                  ball.gravity);
+  release.lower.setConstant(3, -kInf), release.upper.setConstant(3, kInf);
   if (const YAML::Node t = node["speed"]) {
     const auto b = interval(file, t, field + ".speed");
     if (!(b[1] > 0.0)) throw InputError(where(file, t, field + ".speed") + "a release speed is positive");

@@ -72,7 +72,7 @@ std::vector<TimingCheck> checkCenterOfMassTimings(MotionProblem& problem) {
 
   std::vector<Waypoint> waypoints;
   for (const TaskSpec& task : scenario.tasks) {
-    if (task.kind != TaskKind::CenterOfMass || task.window) continue;
+    if (task.task->reads() != TaskQuantity::CenterOfMass || task.window) continue;
     Waypoint w{"task '" + task.name + "'", task.start, false, task.lower.head<2>(), task.upper.head<2>()};
     if (std::isfinite(w.lower.x()) || std::isfinite(w.upper.x()) || std::isfinite(w.lower.y()) || std::isfinite(w.upper.y()))
       waypoints.push_back(w);

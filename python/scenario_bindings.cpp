@@ -18,6 +18,7 @@
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 #include "outer_nlp/scenario_run.hpp"
+#include "outer_nlp/task.hpp"
 #include "python/bindings.hpp"
 #include "python/robot_handle.hpp"
 #include "study/field_path.hpp"
@@ -283,6 +284,15 @@ raised by `progress` stops the run and is raised again. The overrides are those 
 --refine (rounds; the result's 'refinement' says what each found, docs/reference/verify.md).)doc")
       .def("__repr__", [](const ScenarioHandle& s) { return "<mcopt.Scenario " + s.file.string() + ">"; });
 
+  m.def(
+      "task_kinds",
+      [] {
+        py::dict out;
+        for (const TaskKindEntry& e : taskKinds()) out[py::str(e.kind)] = e.description;
+        out["throw"] = "a ball's release and its flight to a target (two rows of three, and the ball's load)";
+        return out;
+      },
+      "The task kinds scenario files name, kind → what it bounds, in the order the documents list them.");
   m.def(
       "verify",
       [](const std::filesystem::path& result, int fine, const std::optional<std::filesystem::path>& scenario,

@@ -3,30 +3,33 @@
 // One task of every kind a scenario may state (but the throw's), on the HRP-2 kick's robot,
 // with bounds on some components and windows and instants inside its 1.6 s: for tests of
 // the outer problem's derivatives.
+#include <cmath>
 #include <limits>
 #include <vector>
 
+#include "core/spatial.hpp"
 #include "outer_nlp/scenario.hpp"
 
 namespace mcopt::test {
 
 inline std::vector<TaskSpec> everyTaskKind(const Scenario& scenario) {
   const double inf = std::numeric_limits<double>::infinity();
-  auto task = [&](TaskKind kind, const char* body, double start, double end) {
+  auto frame = [&](const char* body) { return scenario.robot.frameIndex(body); };
+  auto task = [&](std::shared_ptr<const Task> kind, const char* name, double start, double end) {
     TaskSpec t;
-    t.kind = kind, t.name = body, t.start = start, t.end = end, t.window = end > start;
-    if (kind != TaskKind::CenterOfMass) t.body = body, t.frame = scenario.robot.frameIndex(body);
+    t.task = std::move(kind), t.name = name, t.start = start, t.end = end, t.window = end > start;
     t.lower = Eigen::Vector3d(-0.3, -inf, -1.0), t.upper = Eigen::Vector3d(0.3, 0.5, inf);
     return t;
   };
-  TaskSpec orientation = task(TaskKind::Orientation, "r_sole", 0.2, 0.9);
-  orientation.targetRotation = rotationFromRpy(0.1, -0.2, 0.3);
-  TaskSpec point = task(TaskKind::Position, "RARM_LINK5", 1.1, 1.1);
-  point.point = Vector3(0.02, -0.03, 0.1);
-  TaskSpec velocity = task(TaskKind::LinearVelocity, "HEAD_LINK1", 0.7, 0.7);
-  velocity.point = Vector3(0.1, 0.0, 0.05);
-  return {orientation, point, velocity, task(TaskKind::AngularVelocity, "CHEST_LINK1", 0.5, 0.5),
-          task(TaskKind::CenterOfMass, "", 0.0, 1.6)};
+  TaskSpec angle = task(makeOrientationAngleTask(frame("LARM_LINK6"), rotationFromRpy(0.2, 0.1, -0.3)), "LARM_LINK6",
+                        0.3, 1.2);
+  angle.lower.setConstant(1, -inf), angle.upper.setConstant(1, 1.0 - std::cos(0.4));
+  return {task(makeOrientationTask(frame("r_sole"), rotationFromRpy(0.1, -0.2, 0.3)), "r_sole", 0.2, 0.9),
+          task(makePositionTask(frame("RARM_LINK5"), Vector3(0.02, -0.03, 0.1)), "RARM_LINK5", 1.1, 1.1),
+          task(makeLinearVelocityTask(frame("HEAD_LINK1"), Vector3(0.1, 0.0, 0.05)), "HEAD_LINK1", 0.7, 0.7),
+          task(makeAngularVelocityTask(frame("CHEST_LINK1")), "CHEST_LINK1", 0.5, 0.5),
+          task(makeCenterOfMassTask(), "", 0.0, 1.6),
+          angle};
 }
 
 }  // namespace mcopt::test

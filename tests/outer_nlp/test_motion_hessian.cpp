@@ -320,8 +320,8 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
       s.samples = 11;
       s.continuation.clear();
       for (TaskSpec& t : s.tasks) {
-        if (t.kind == TaskKind::ThrowLanding) t.lower[2] = 0.1, t.upper[2] = 3.0;  // flight time [s]
-        if (t.kind == TaskKind::ThrowRelease) t.lower.head<2>() << 0.5, -1.0, t.upper.head<2>() << 20.0, 1.4;
+        if (t.task->kind() == "throw_landing") t.lower[2] = 0.1, t.upper[2] = 3.0;  // flight time [s]
+        if (t.task->kind() == "throw_release") t.lower.head<2>() << 0.5, -1.0, t.upper.head<2>() << 20.0, 1.4;
       }
     }
     s.outputSamples = 20;

@@ -177,8 +177,8 @@ TEST_CASE("throw: exact derivatives of the throw rows and the carried ball, fixe
       s.fixStart = s.fixEnd = false;
       // Every optional row bounded, so that each is in the Jacobian.
       for (TaskSpec& t : s.tasks) {
-        if (t.kind == TaskKind::ThrowLanding) t.lower[2] = 0.1, t.upper[2] = 2.0;
-        if (t.kind == TaskKind::ThrowRelease) t.lower.head<2>() << 1.0, -0.5, t.upper.head<2>() << 9.0, 1.2;
+        if (t.task->kind() == "throw_landing") t.lower[2] = 0.1, t.upper[2] = 2.0;
+        if (t.task->kind() == "throw_release") t.lower.head<2>() << 1.0, -0.5, t.upper.head<2>() << 9.0, 1.2;
       }
       // With a free duration the release t_r = 0.6 T moves with it: a free release time.
       if (freeDuration) s.duration.lower = 1.5, s.duration.upper = 3.0;

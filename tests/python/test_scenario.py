@@ -46,6 +46,13 @@ def test_fields_by_path():
         s["tasks[jump].target"]
 
 
+def test_the_registry_lists_the_task_kinds():
+    kinds = mcopt.task_kinds()
+    assert list(kinds) == ["position", "orientation", "orientation_angle", "linear_velocity", "angular_velocity",
+                           "center_of_mass", "throw"]
+    assert all(isinstance(d, str) and d for d in kinds.values())
+
+
 def test_a_refused_value_raises_the_loader_message_and_changes_nothing(mcopt_exe, tmp_path):
     s = mcopt.Scenario(KICK)
     with pytest.raises(mcopt.InputError) as raised:
