@@ -73,9 +73,10 @@ void BallFlightTask::calcDiff(const DynamicsModel& model, const DynamicsData& da
   const BallisticFlight f = ballisticFlight(ball.position, ball.velocity, target_.z(), gravity_);
   Eigen::Matrix<double, 3, 6> gradient;  // of the three components in (p, v)
   value = flightQuantities(f, part_, target_, gradient);
-  dq.noalias() = gradient.leftCols<3>() * w.jacobian.topRows<3>();
-  dq.noalias() += gradient.rightCols<3>() * w.velocityDq;
-  dv.noalias() = gradient.rightCols<3>() * w.jacobian.topRows<3>();
+  ThreeRows q3 = threeRows(dq);
+  q3.noalias() = gradient.leftCols<3>() * w.jacobian.topRows<3>();
+  q3.noalias() += gradient.rightCols<3>() * w.velocityDq;
+  threeRows(dv).noalias() = gradient.rightCols<3>() * w.jacobian.topRows<3>();
 }
 
 void BallFlightTask::flightCurvature(const DynamicsModel& model, const DynamicsData& data, const Vector3& multipliers,

@@ -523,8 +523,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         taskOutputs(i, true, w, taskProbe);
         component = saved;
         if (closure_) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
-        gradient.head(n).noalias() = taskProbe.dyDq.transpose() * lambda;
-        if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.transpose() * lambda;
+        gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
+        if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
         if (closure_) foldGradient(h.probeMap, b.closed, taskBlocks, gradient);
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }

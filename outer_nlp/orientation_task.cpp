@@ -27,7 +27,7 @@ class OrientationTask final : public Task {
     frameJacobian(model, data, model.framePosition(frame_), pose.translation, w.jacobian);
     Matrix3 g;
     for (int i = 0; i < 3; ++i) g.col(i) = antisymmetricPart(target_.transpose() * skew(Vector3::Unit(i)) * pose.rotation);
-    dq.noalias() = g * w.jacobian.bottomRows<3>();
+    threeRows(dq).noalias() = g * w.jacobian.bottomRows<3>();
     dv.setZero();
   }
 

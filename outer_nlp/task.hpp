@@ -52,6 +52,14 @@ struct TaskWorkspace {
 
 class BallFlightTask;
 
+/// A three-row task's derivative rows as a fixed-size view: its products then take Eigen's
+/// fixed-size kernels, the arithmetic the three-row kinds had before they were models (a
+/// dynamic-size destination sums in another order, and moved bundled optima by rounding).
+using ThreeRows = Eigen::Map<Eigen::Matrix3Xd, Eigen::Unaligned, Eigen::OuterStride<>>;
+inline ThreeRows threeRows(Eigen::Ref<Eigen::MatrixXd> m) {
+  return ThreeRows(m.data(), 3, m.cols(), Eigen::OuterStride<>(m.outerStride()));
+}
+
 /// va(M) = ½ vee(M − Mᵀ), vee(A) = (A₃₂, A₁₃, A₂₁): the orientation tasks' errors.
 inline Vector3 antisymmetricPart(const Matrix3& m) {
   return 0.5 * Vector3(m(2, 1) - m(1, 2), m(0, 2) - m(2, 0), m(1, 0) - m(0, 1));

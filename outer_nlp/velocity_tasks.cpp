@@ -32,10 +32,11 @@ class LinearVelocityTask final : public Task {
     frameJacobian(model, data, position, point, w.jacobian);
     bodyMotionDerivatives(model, data, position, w.dTwistDq, w.dTwistDv, w.dAccelerationDq, w.dAccelerationDv,
                           w.dAccelerationDa);
-    dq = w.dTwistDq.topRows<3>();
-    dq.noalias() -= skew(point) * w.dTwistDq.bottomRows<3>();
-    dq.noalias() += skew(omega) * w.jacobian.topRows<3>();
-    dv = w.jacobian.topRows<3>();
+    ThreeRows q3 = threeRows(dq);
+    q3 = w.dTwistDq.topRows<3>();
+    q3.noalias() -= skew(point) * w.dTwistDq.bottomRows<3>();
+    q3.noalias() += skew(omega) * w.jacobian.topRows<3>();
+    threeRows(dv) = w.jacobian.topRows<3>();
   }
 
  private:
@@ -61,8 +62,8 @@ class AngularVelocityTask final : public Task {
     frameJacobian(model, data, position, framePose(model, data, frame_).translation, w.jacobian);
     bodyMotionDerivatives(model, data, position, w.dTwistDq, w.dTwistDv, w.dAccelerationDq, w.dAccelerationDv,
                           w.dAccelerationDa);
-    dq = w.dTwistDq.bottomRows<3>();
-    dv = w.jacobian.bottomRows<3>();
+    threeRows(dq) = w.dTwistDq.bottomRows<3>();
+    threeRows(dv) = w.jacobian.bottomRows<3>();
   }
 
  private:
