@@ -228,9 +228,11 @@ TEST_CASE("sample-differences Hessian: the kick against differences of the exact
     const char* name;
     bool freeDuration, epigraph;
     double accelerationWeight;
+    bool everyTask = false;  // a one-row task beside three-row ones
   };
   for (const Case& c : {Case{"fixed T, smooth maximum", false, false, 0.0}, Case{"free T, smooth maximum", true, false, 0.0},
-                        Case{"fixed T, epigraph", false, true, 0.0}, Case{"free T, regularised", true, false, 1e-3}}) {
+                        Case{"fixed T, epigraph", false, true, 0.0}, Case{"free T, regularised", true, false, 1e-3},
+                        Case{"fixed T, every task kind", false, false, 0.0, true}}) {
 #ifdef MCOPT_UNDER_SANITIZERS
     if (c.accelerationWeight == 0.0 && !c.epigraph) continue;  // the epigraph and the free, regularised T; Release runs all four
 #endif
@@ -238,6 +240,7 @@ TEST_CASE("sample-differences Hessian: the kick against differences of the exact
     if (c.freeDuration) s.duration.lower = 1.2, s.duration.upper = 2.0;
     if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
     s.accelerationWeight = c.accelerationWeight;
+    if (c.everyTask) s.tasks = test::everyTaskKind(s);
     MotionProblem problem(s);
     Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 3);
     if (c.freeDuration) x[problem.parametrization().parameterCount()] = 1.5;
