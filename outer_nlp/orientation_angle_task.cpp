@@ -54,8 +54,7 @@ std::shared_ptr<const Task> makeOrientationAngleTask(int frame, const Matrix3& t
 }
 
 ReadTask readOrientationAngleTask(const TaskFields& fields) {
-  if (!fields.has("target")) fields.fail("target", "missing required field (rpy of the target)");
-  const std::vector<double> r = fields.numbers("target", 3);
+  const Matrix3 target = readTargetRotation(fields);
   if (!fields.has("tolerance")) fields.fail("tolerance", "missing required field (the angle [rad])");
   const double tolerance = fields.number("tolerance");
   // At 0 the row's bound would sit at its minimum, where its gradient vanishes; from π on it
@@ -63,7 +62,7 @@ ReadTask readOrientationAngleTask(const TaskFields& fields) {
   if (!(tolerance > 0.0 && tolerance < kPi))
     fields.fail("tolerance", "expected an angle in (0, π) rad");
   ReadTask out;
-  out.task = makeOrientationAngleTask(fields.body("body"), rotationFromRpy(r[0], r[1], r[2]));
+  out.task = makeOrientationAngleTask(fields.body("body"), target);
   out.lower.setConstant(1, -std::numeric_limits<double>::infinity());
   out.upper.setConstant(1, 1.0 - std::cos(tolerance));
   return out;

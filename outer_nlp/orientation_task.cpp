@@ -43,15 +43,14 @@ std::shared_ptr<const Task> makeOrientationTask(int frame, const Matrix3& target
 }
 
 ReadTask readOrientationTask(const TaskFields& fields) {
-  if (!fields.has("target")) fields.fail("target", "missing required field (rpy of the target)");
-  const std::vector<double> r = fields.numbers("target", 3);
+  const Matrix3 target = readTargetRotation(fields);
   double tolerance = 0.0;
   if (fields.has("tolerance")) {
     tolerance = fields.number("tolerance");
     if (!(tolerance >= 0.0)) fields.fail("tolerance", "expected a number ≥ 0");
   }
   ReadTask out;
-  out.task = makeOrientationTask(fields.body("body"), rotationFromRpy(r[0], r[1], r[2]));
+  out.task = makeOrientationTask(fields.body("body"), target);
   out.lower.setConstant(3, -tolerance);
   out.upper.setConstant(3, tolerance);
   return out;

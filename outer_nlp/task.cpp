@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "core/spatial.hpp"
+
 namespace mcopt {
 
 // Each kind's reader, in its own file.
@@ -65,6 +67,12 @@ TaskWorkspace::TaskWorkspace(const DynamicsModel& model)
       velocityDq(3, model.jointCount()),
       ballJacobian(6, 2 * model.jointCount()),
       weightedBallJacobian(6, 2 * model.jointCount()) {}
+
+Matrix3 readTargetRotation(const TaskFields& fields) {
+  if (!fields.has("target")) fields.fail("target", "missing required field (rpy of the target)");
+  const std::vector<double> r = fields.numbers("target", 3);
+  return rotationFromRpy(r[0], r[1], r[2]);
+}
 
 void readTargetOrBounds(const TaskFields& fields, int dimension, ReadTask& out) {
   constexpr double kInf = std::numeric_limits<double>::infinity();

@@ -137,6 +137,8 @@ std::string taskKindList();
 /// Bounds of a task of `dimension` rows from `target` (null entries free) and `tolerance`, or
 /// from `lower` and `upper` (null for a free end): the reading of the vector kinds.
 void readTargetOrBounds(const TaskFields& fields, int dimension, ReadTask& out);
+/// The orientation kinds' required `target`, `[roll, pitch, yaw]`, as a rotation.
+Matrix3 readTargetRotation(const TaskFields& fields);
 
 // The bundled kinds, for the tasks the scenario makes itself (a contact's closure) and tests.
 /// The point `point` (body frame) of `frame`'s body, world frame.
