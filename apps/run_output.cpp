@@ -207,8 +207,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
     result["power_fine"] = nullptr;
   Json byKind = Json::object();
   byKind["position_limit"] = violations.positionLimit;
-  for (int k = 0; k < kConstraintKindCount; ++k)
-    byKind[constraintKindName(static_cast<ConstraintKind>(k))] = violations.byKind[static_cast<std::size_t>(k)];
+  for (const auto& [kind, worst] : violations.byKind) byKind[kind] = worst;
   result["violation_by_kind"] = byKind;
   if (violations.worstRow >= 0) result["worst_constraint"] = problem.rowName(violations.worstRow);
   result["solver"] = {{"name", "ipopt"},

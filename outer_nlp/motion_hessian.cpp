@@ -238,18 +238,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
   const int n = jointCount_, curved = nonlinearVariableCount(), N = samples_.sampleCount();
   const double T = duration(x);
 
-  // Each row's multiplier on the output it reads (an epigraph row reads −P).
+  // Each row's multiplier on the output it reads, times the term's sign (an epigraph row reads
+  // −P); a slack enters linearly.
   sampleMultipliers_.setZero(outputs_.size(), N);
   taskMultipliers_.setZero(taskRows_, static_cast<Eigen::Index>(taskBlocks_.size()));
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
-    const double lambda = multipliers[static_cast<Eigen::Index>(r)];
-    switch (row.kind) {
-      case ConstraintKind::VelocityLimit: break;  // linear in x at a fixed duration
-      case ConstraintKind::Task:
-      case ConstraintKind::Closure: taskMultipliers_(row.output, row.block) += lambda; break;
-      case ConstraintKind::Epigraph: sampleMultipliers_(row.output, row.block) -= lambda; break;
-      default: sampleMultipliers_(row.output, row.block) += lambda; break;
+    const ConstraintTerm& term = *terms_[static_cast<std::size_t>(row.term)];
+    const double lambda = term.outputSign() * multipliers[static_cast<Eigen::Index>(r)];
+    switch (term.place()) {
+      case RowPlace::ControlPoints: break;  // linear in x at a fixed duration: the duration's part below
+      case RowPlace::TaskInstant: taskMultipliers_(row.output, row.block) += lambda; break;
+      case RowPlace::Sample: sampleMultipliers_(row.output, row.block) += lambda; break;
     }
   }
 
@@ -552,18 +552,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         hessian(l.columns[static_cast<std::size_t>(r)], l.columns[static_cast<std::size_t>(c)]) += l.values(r, c);
 
   if (durationIsFree() && scenario_.hessian == HessianOption::Exact) {
-    // The samples and task instants brought theirs; the velocity-limit rows
-    // λ scale (x_second − x_first) / T add ∓λ scale / T² and 2 λ scale (x_second − x_first) / T³.
+    // The samples and task instants brought theirs; the control-point rows (the velocity
+    // limits, (x_second − x_first) / T) bring their own terms' curvature in T.
     const int column = parameterCount_;
     for (std::size_t r = 0; r < rows_.size(); ++r) {
-      if (rows_[r].kind != ConstraintKind::VelocityLimit) continue;
-      const VelocityRow& v = velocityRows_[static_cast<std::size_t>(rows_[r].block)];
-      const double lambda = multipliers[static_cast<Eigen::Index>(r)] * v.scale;
-      for (const auto& [variable, sign] : {std::pair{v.second, -1.0}, std::pair{v.first, 1.0}}) {
-        hessian(column, variable) += sign * lambda / (T * T);
-        hessian(variable, column) += sign * lambda / (T * T);
-      }
-      hessian(column, column) += 2.0 * lambda * (x[v.second] - x[v.first]) / (T * T * T);
+      const ConstraintTerm& term = *terms_[static_cast<std::size_t>(rows_[r].term)];
+      if (term.place() == RowPlace::ControlPoints)
+        term.addDirectHessian(rows_[r].detail, multipliers[static_cast<Eigen::Index>(r)], x, T, column, hessian);
     }
   } else if (durationIsFree()) {
     // The duration's row and column: a forward difference of the whole gradient.

@@ -113,35 +113,7 @@ RigidTransform supportPose(const DynamicsModel& model, const ContactSurface& sur
   return framePose(model, data, surface.frame) * surface.placement;
 }
 
-/// The row kind a contact-model row is reported under.
-ConstraintKind contactConstraintKind(ContactRowKind kind) {
-  switch (kind) {
-    case ContactRowKind::NormalForce: return ConstraintKind::ContactUnilateral;
-    case ContactRowKind::CenterOfPressure: return ConstraintKind::ContactCop;
-    case ContactRowKind::Friction: return ConstraintKind::ContactFriction;
-    case ContactRowKind::Yaw: return ConstraintKind::ContactYaw;
-  }
-  return ConstraintKind::ContactFriction;
-}
-
 }  // namespace
-
-const char* constraintKindName(ConstraintKind kind) {
-  switch (kind) {
-    case ConstraintKind::VelocityLimit: return "velocity_limit";
-    case ConstraintKind::TorqueLimit: return "torque_limit";
-    case ConstraintKind::ContactUnilateral: return "contact_unilateral";
-    case ConstraintKind::ContactFriction: return "contact_friction";
-    case ConstraintKind::ContactCop: return "contact_cop";
-    case ConstraintKind::ContactYaw: return "contact_yaw";
-    case ConstraintKind::InnerFeasibility: return "inner_feasibility";
-    case ConstraintKind::Closure: return "closure";
-    case ConstraintKind::Task: return "task";
-    case ConstraintKind::Epigraph: return "energy_epigraph";
-    case ConstraintKind::ClosingJointLimit: return "closing_joint_limit";
-  }
-  return "?";
-}
 
 MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows)
     : scenario_(scenario),
@@ -244,20 +216,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   for (int j = 0; j < jointCount_; ++j)
     if (scenario_.torqueLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit))
       torqueJoints_.push_back(j);
-  const auto& knots = parametrization_.basis().knots();
   const int m = parametrization_.parametersPerJoint();
-  for (int j = 0; j < jointCount_ && scenario_.velocityLimits; ++j) {
-    if (!std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].velocityLimit)) continue;
-    // A whole-motion contact's closing joint: its limit is a row at every sample (a window's
-    // keeps its spline's rows for the instants outside it, and rows at the samples inside).
-    if (closure_ && closure_->closes(j) && closure_->wholeMotion(closure_->contactOf(j))) continue;
-    for (int k = 0; k + 1 < parametrization_.controlPointCount(); ++k) {
-      const int first = parametrization_.parameterOfControlPoint(k), second = parametrization_.parameterOfControlPoint(k + 1);
-      if (first == second) continue;  // the clamped ends: identically zero
-      velocityRows_.push_back({j, j * m + first, j * m + second,
-                               3.0 / (knots[static_cast<std::size_t>(k) + 4] - knots[static_cast<std::size_t>(k) + 1])});
-    }
-  }
 
   const int outputs = outputs_.size();
   // The task buffers' rows: the largest task dimension (3 unless every task has fewer, or one more).
@@ -341,6 +300,9 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       for (int l = 0; l < m && closure_->closes(j); ++l)
         unusedParameter_[static_cast<std::size_t>(j * m + l)] = !used[static_cast<std::size_t>(j * m + l)];
   }
+  terms_ = makeConstraintTerms(TermContext{scenario_, parametrization_, outputs_, closure_.get(), support_, contactRows_, bilevel_,
+                                           relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_,
+                                           taskOfInstant_});
   buildStructure();
 }
 
@@ -392,129 +354,95 @@ MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
 }
 
 void MotionProblem::buildStructure() {
-  // The one place rows and their Jacobian entries are enumerated.
+  // The one place rows and their Jacobian entries are enumerated: each term lays out its rows
+  // (constraint_term.hpp) through this registry, the control points' first, then sample by
+  // sample the terms in their order, then the task instants'.
   std::vector<int> rows, columns;
-  const bool freeT = durationIsFree();
   using Source = JacobianEntry::Source;
-  auto entry = [&](int column, JacobianEntry e) {
-    rows.push_back(static_cast<int>(rows_.size()) - 1), columns.push_back(column), entries_.push_back(e);
+  class Registry final : public RowSink {
+   public:
+    Registry(MotionProblem& problem, std::vector<int>& rows, std::vector<int>& columns)
+        : p_(problem), rows_(rows), columns_(columns), freeT_(problem.durationIsFree()) {}
+    void start(int term, bool task, int block) {
+      term_ = term, task_ = task, block_ = block;
+      sign_ = p_.terms_[static_cast<std::size_t>(term)]->outputSign();
+      b_ = block < 0 ? nullptr : task ? &p_.taskBlocks_[static_cast<std::size_t>(block)] : &p_.blocks_[static_cast<std::size_t>(block)];
+    }
+    int block() const override { return block_; }
+    ClosureSet closed() const override { return b_->closed; }
+    int forceColumnCount(int contact) const override {
+      int count = 0;
+      for (const SampleBlock::ForceTerm& t : b_->forceTerms) count += t.contact == contact ? 6 : 0;
+      return count;
+    }
+    int slackColumn(int joint) const override { return p_.slackIndex(block_, joint); }
+    void outputRow(int detail, int output, const std::vector<int>& dependsOn, bool withForces, int slack) override {
+      p_.rows_.push_back({term_, detail, block_, output, slack});
+      const SampleBlock& b = *b_;
+      const int k = static_cast<int>(b.parameters.size()) / p_.jointCount_;
+      for (const int j : dependsOn)
+        for (int l = 0; l < k; ++l) entry(b.parameters[j * k + l], {Source::Parameter, task_, block_, output, j * k + l, sign_});
+      if (freeT_) entry(p_.parameterCount_, {Source::Duration, task_, block_, output, -1, sign_});
+      if (withForces)
+        for (std::size_t c = 0; c < b.forceColumns.size(); ++c)
+          entry(b.forceColumns[c], {Source::Force, task_, block_, output, static_cast<int>(c), sign_});
+      if (slack >= 0) entry(slack, {Source::Slack, false, block_, -1, -1, 1.0});
+    }
+    void contactRow(int detail, int output, int contact) override {
+      p_.rows_.push_back({term_, detail, block_, output, -1});
+      for (const SampleBlock::ForceTerm& t : b_->forceTerms)
+        for (int l = t.firstColumn; t.contact == contact && l < t.firstColumn + 6; ++l)
+          entry(b_->forceColumns[static_cast<std::size_t>(l)], {Source::Force, task_, block_, output, l, sign_});
+    }
+    void directRow(int detail, int first, int second) override {
+      p_.rows_.push_back({term_, detail, -1, -1, -1});
+      entry(first, {Source::Direct, false, -1, -1, 0, 1.0});
+      entry(second, {Source::Direct, false, -1, -1, 1, 1.0});
+      if (freeT_) entry(p_.parameterCount_, {Source::Direct, false, -1, -1, 2, 1.0});
+    }
+
+   private:
+    void entry(int column, JacobianEntry e) {
+      rows_.push_back(static_cast<int>(p_.rows_.size()) - 1), columns_.push_back(column), p_.entries_.push_back(e);
+    }
+    MotionProblem& p_;
+    std::vector<int>& rows_;
+    std::vector<int>& columns_;
+    const bool freeT_;
+    int term_ = 0, block_ = -1;
+    bool task_ = false;
+    double sign_ = 1.0;
+    const SampleBlock* b_ = nullptr;
   };
-  for (std::size_t v = 0; v < velocityRows_.size(); ++v) {
-    const VelocityRow& velocity = velocityRows_[v];
-    const int block = static_cast<int>(v);
-    rows_.push_back({ConstraintKind::VelocityLimit, velocity.joint, block, -1});
-    entry(velocity.first, {Source::VelocityFirst, false, block, -1, -1, 1.0});
-    entry(velocity.second, {Source::VelocitySecond, false, block, -1, -1, 1.0});
-    if (freeT) entry(parameterCount_, {Source::VelocityDuration, false, block, -1, -1, 1.0});
-  }
-  // A row reading output `output` of sample (or task instant) `block`: the local parameters
-  // of the joints it depends on, T, and (`withForces`) the sample's force columns.
-  auto sampleRow = [&](ConstraintKind kind, int detail, bool task, int block, int output, double sign,
-                       const std::vector<int>& dependsOn, bool withForces) {
-    rows_.push_back({kind, detail, block, output});
-    const SampleBlock& b = task ? taskBlocks_[static_cast<std::size_t>(block)] : blocks_[static_cast<std::size_t>(block)];
-    const int k = static_cast<int>(b.parameters.size()) / jointCount_;
-    for (const int j : dependsOn)
-      for (int l = 0; l < k; ++l) entry(b.parameters[j * k + l], {Source::Parameter, task, block, output, j * k + l, sign});
-    if (freeT) entry(parameterCount_, {Source::Duration, task, block, output, -1, sign});
-    if (withForces)
-      for (std::size_t c = 0; c < b.forceColumns.size(); ++c)
-        entry(b.forceColumns[c], {Source::Force, task, block, output, static_cast<int>(c), sign});
+  Registry registry(*this, rows, columns);
+  const auto layOut = [&](RowPlace place, bool task, int block) {
+    for (std::size_t t = 0; t < terms_.size(); ++t)
+      if (terms_[t]->place() == place) registry.start(static_cast<int>(t), task, block), terms_[t]->appendRows(registry);
   };
-  const bool explicitForces = !bilevel_;
-  const int contacts = outputs_.contacts;
-  for (int s = 0; s < samples_.sampleCount(); ++s) {
-    for (const int j : torqueJoints_)
-      if (omittedTorqueRows_.empty() || !omittedTorqueRows_[static_cast<std::size_t>(s * jointCount_ + j)])
-        sampleRow(ConstraintKind::TorqueLimit, j, false, s, outputs_.torque(j), 1.0, relatedJoints_[static_cast<std::size_t>(j)],
-                true);
-    if (scenario_.contactConstraints && explicitForces) {
-      for (int c = 0; c < support_.rowCount(); ++c)
-        sampleRow(contactConstraintKind(support_.rowKind(c)), c, false, s, outputs_.referenceRow(c), 1.0, allJoints_, true);
-      // An environment contact's rows read its own wrench, in its own frame: only its variables.
-      const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-      int firstColumn = 0;
-      for (int i = 0; i < contacts; ++i) {
-        const int width = 6 * static_cast<int>(forces_->terms(i, s).size());
-        const ContactAdmissibilityRows& own = contactRows_[static_cast<std::size_t>(i)];
-        for (int c = 0; c < own.rowCount() && width > 0; ++c) {
-          rows_.push_back({contactConstraintKind(own.rowKind(c)), outputs_.contactRowStart[static_cast<std::size_t>(i) + 1] + c, s,
-                           outputs_.contactRow(i, c)});
-          for (int l = firstColumn; l < firstColumn + width; ++l)
-            entry(b.forceColumns[static_cast<std::size_t>(l)], {Source::Force, false, s, outputs_.contactRow(i, c), l, 1.0});
-        }
-        firstColumn += width;
-      }
-    }
-    if (bilevel_)
-      sampleRow(ConstraintKind::InnerFeasibility, 0, false, s, outputs_.infeasibility(), 1.0, allJoints_, false);
-    for (int k = 0; k < outputs_.closing; ++k) {
-      const int joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
-      if (!closure_->closesIn(joint, blocks_[static_cast<std::size_t>(s)].closed)) continue;  // a spline here: its control points' bounds
-      if (scenario_.positionLimits)
-        sampleRow(ConstraintKind::ClosingJointLimit, k, false, s, outputs_.closingPosition(k), 1.0, allJoints_, false);
-      if (scenario_.velocityLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit))
-        sampleRow(ConstraintKind::ClosingJointLimit, outputs_.closing + k, false, s, outputs_.closingVelocity(k), 1.0, allJoints_,
-                  false);
-    }
-    if (scenario_.energyForm == EnergyForm::Epigraph)
-      for (int j = 0; j < jointCount_; ++j) {
-        sampleRow(ConstraintKind::Epigraph, j, false, s, outputs_.power(j), -1.0, relatedJoints_[static_cast<std::size_t>(j)],
-                  true);
-        entry(slackIndex(s, j), {Source::Slack, false, s, -1, -1, 1.0});
-      }
-  }
-  for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
-    const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])];
-    for (int c = 0; c < task.dimension(); ++c) {
-      if (!std::isfinite(task.lower[c]) && !std::isfinite(task.upper[c])) continue;
-      sampleRow(task.closure ? ConstraintKind::Closure : ConstraintKind::Task, c, true, static_cast<int>(i), c, 1.0,
-                taskJoints_[i], false);
-    }
-  }
+  layOut(RowPlace::ControlPoints, false, -1);
+  for (int s = 0; s < samples_.sampleCount(); ++s) layOut(RowPlace::Sample, false, s);
+  for (std::size_t i = 0; i < taskBlocks_.size(); ++i) layOut(RowPlace::TaskInstant, true, static_cast<int>(i));
   jacobianRows_ = Eigen::Map<Eigen::VectorXi>(rows.data(), static_cast<Eigen::Index>(rows.size()));
   jacobianColumns_ = Eigen::Map<Eigen::VectorXi>(columns.data(), static_cast<Eigen::Index>(columns.size()));
+}
+
+std::vector<ConstraintKindInfo> MotionProblem::rowKinds() const {
+  std::vector<ConstraintKindInfo> kinds;
+  for (const auto& term : terms_)
+    for (const ConstraintKindInfo& k : term->kinds()) kinds.push_back(k);
+  return kinds;
+}
+
+double MotionProblem::Violations::of(std::string_view kind) const {
+  for (const auto& [name, worst] : byKind)
+    if (name == kind) return worst;
+  throw std::out_of_range("no constraint term lays out rows of kind '" + std::string(kind) + "'");
 }
 
 std::string MotionProblem::rowSubject(int row) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
   std::ostringstream name;
-  switch (r.kind) {
-    case ConstraintKind::VelocityLimit:
-      name << "velocity limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
-      break;
-    case ConstraintKind::TorqueLimit:
-      name << "torque limit of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
-      break;
-    case ConstraintKind::ContactUnilateral:
-    case ConstraintKind::ContactFriction:
-    case ConstraintKind::ContactCop:
-    case ConstraintKind::ContactYaw: {
-      int contact = 0;  // 0: the reference contact, 1 + i: environment contact i
-      while (r.detail >= outputs_.contactRowStart[static_cast<std::size_t>(contact) + 1]) ++contact;
-      const ContactAdmissibilityRows& rows = contact == 0 ? support_ : contactRows_[static_cast<std::size_t>(contact - 1)];
-      name << (contact == 0 ? scenario_.support.name : scenario_.contacts[static_cast<std::size_t>(contact - 1)].surface.name)
-           << " " << rows.rowName(r.detail - outputs_.contactRowStart[static_cast<std::size_t>(contact)]);
-      break;
-    }
-    case ConstraintKind::InnerFeasibility: name << "inner problem feasibility (balance slack)"; break;
-    case ConstraintKind::ClosingJointLimit: {
-      const int k = r.detail % outputs_.closing, joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
-      name << (r.detail < outputs_.closing ? "position" : "velocity") << " limit of "
-           << scenario_.robot.joints[static_cast<std::size_t>(joint)].name << " (closing "
-           << closure_->contacts()[static_cast<std::size_t>(closure_->contactOf(joint))].name << ")";
-      break;
-    }
-    case ConstraintKind::Epigraph:
-      name << "energy epigraph of " << scenario_.robot.joints[static_cast<std::size_t>(r.detail)].name;
-      break;
-    case ConstraintKind::Closure:
-    case ConstraintKind::Task: {
-      const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(r.block)])];
-      name << (task.closure ? "" : "task '") << task.name << (task.closure ? "" : "'") << " component " << task.task->componentName(r.detail);
-      break;
-    }
-  }
+  terms_[static_cast<std::size_t>(r.term)]->subject(r.detail, r.block, name);
   return name.str();
 }
 
@@ -522,23 +450,22 @@ std::string MotionProblem::rowName(int row) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
   std::ostringstream name;
   name << rowSubject(row);
-  switch (r.kind) {
-    case ConstraintKind::VelocityLimit: name << " (control points)"; break;
-    case ConstraintKind::Closure:
-    case ConstraintKind::Task: name << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion"; break;
-    default: name << " at sample " << r.block;
+  switch (terms_[static_cast<std::size_t>(r.term)]->place()) {
+    case RowPlace::ControlPoints: name << " (control points)"; break;
+    case RowPlace::TaskInstant: name << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion"; break;
+    case RowPlace::Sample: name << " at sample " << r.block; break;
   }
   return name.str();
 }
 
 double MotionProblem::rowTime(int row, double T) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
-  switch (r.kind) {
-    case ConstraintKind::VelocityLimit: return std::numeric_limits<double>::quiet_NaN();
-    case ConstraintKind::Closure:
-    case ConstraintKind::Task: return taskSamples_.time(r.block, T);
-    default: return T * sampleTimes_[static_cast<std::size_t>(r.block)];
+  switch (terms_[static_cast<std::size_t>(r.term)]->place()) {
+    case RowPlace::ControlPoints: return std::numeric_limits<double>::quiet_NaN();
+    case RowPlace::TaskInstant: return taskSamples_.time(r.block, T);
+    case RowPlace::Sample: break;
   }
+  return T * sampleTimes_[static_cast<std::size_t>(r.block)];
 }
 
 void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
@@ -580,41 +507,7 @@ void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& up
   upper.resize(constraintCount());
   for (int r = 0; r < constraintCount(); ++r) {
     const Row& row = rows_[static_cast<std::size_t>(r)];
-    switch (row.kind) {
-      case ConstraintKind::VelocityLimit: {
-        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(row.detail)].velocityLimit;
-        lower[r] = -limit, upper[r] = limit;
-        break;
-      }
-      case ConstraintKind::TorqueLimit: {
-        const double limit = scenario_.actuators.joints[static_cast<std::size_t>(row.detail)].torqueLimit;
-        lower[r] = -limit, upper[r] = limit;
-        break;
-      }
-      case ConstraintKind::ContactUnilateral: lower[r] = scenario_.minimumNormalForce, upper[r] = kInf; break;
-      case ConstraintKind::ClosingJointLimit: {
-        const int k = row.detail % outputs_.closing, joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
-        if (row.detail < outputs_.closing) {
-          const JointLimits& limit = scenario_.robot.joints[static_cast<std::size_t>(joint)].limits;
-          lower[r] = limit.lower, upper[r] = limit.upper;
-        } else {
-          const double limit = scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit;
-          lower[r] = -limit, upper[r] = limit;
-        }
-        break;
-      }
-      case ConstraintKind::InnerFeasibility: lower[r] = -kInf, upper[r] = 0.0; break;
-      case ConstraintKind::ContactFriction:
-      case ConstraintKind::ContactCop:
-      case ConstraintKind::ContactYaw:
-      case ConstraintKind::Epigraph: lower[r] = 0.0, upper[r] = kInf; break;
-      case ConstraintKind::Closure:
-      case ConstraintKind::Task: {
-        const TaskSpec& task = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(row.block)])];
-        lower[r] = task.lower[row.detail], upper[r] = task.upper[row.detail];
-        break;
-      }
-    }
+    terms_[static_cast<std::size_t>(row.term)]->bounds(row.detail, row.block, lower[r], upper[r]);
   }
 }
 
@@ -1185,17 +1078,14 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
 }
 
 double MotionProblem::rowValue(const Row& row, const Eigen::VectorXd& x, double T) const {
-  switch (row.kind) {
-    case ConstraintKind::VelocityLimit: {
-      const VelocityRow& v = velocityRows_[static_cast<std::size_t>(row.block)];
-      return v.scale * (x[v.second] - x[v.first]) / T;
-    }
-    case ConstraintKind::Closure:
-    case ConstraintKind::Task: return taskBlocks_[static_cast<std::size_t>(row.block)].y[row.output];
-    case ConstraintKind::Epigraph:
-      return x[slackIndex(row.block, row.detail)] - blocks_[static_cast<std::size_t>(row.block)].y[row.output];
-    default: return blocks_[static_cast<std::size_t>(row.block)].y[row.output];
+  const ConstraintTerm& term = *terms_[static_cast<std::size_t>(row.term)];
+  switch (term.place()) {
+    case RowPlace::ControlPoints: return term.directValue(row.detail, x, T);
+    case RowPlace::TaskInstant: return taskBlocks_[static_cast<std::size_t>(row.block)].y[row.output];
+    case RowPlace::Sample: break;
   }
+  const double y = term.outputSign() * blocks_[static_cast<std::size_t>(row.block)].y[row.output];
+  return row.slack >= 0 ? x[row.slack] + y : y;
 }
 
 void MotionProblem::constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) {
@@ -1220,11 +1110,9 @@ void MotionProblem::jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& va
       case Source::Duration: value = b->dyDT[e.output]; break;
       case Source::Force: value = b->dyDz(e.output, e.local); break;
       case Source::Slack: value = 1.0; break;
-      case Source::VelocityFirst: value = -velocityRows_[block].scale / T; break;
-      case Source::VelocitySecond: value = velocityRows_[block].scale / T; break;
-      case Source::VelocityDuration: {
-        const VelocityRow& v = velocityRows_[block];
-        value = -v.scale * (x[v.second] - x[v.first]) / (T * T);
+      case Source::Direct: {
+        const Row& row = rows_[static_cast<std::size_t>(jacobianRows_[static_cast<Eigen::Index>(k)])];
+        value = terms_[static_cast<std::size_t>(row.term)]->directDerivative(row.detail, e.local, x, T);
         break;
       }
     }
@@ -1241,9 +1129,11 @@ MotionProblem::Violations MotionProblem::violations(const Eigen::VectorXd& x) {
   v.overall = v.positionLimit;
   constraints(x, g);
   constraintBounds(gl, gu);
+  for (const ConstraintKindInfo& k : rowKinds()) v.byKind.emplace_back(std::string(k.name), 0.0);
   for (int r = 0; r < constraintCount(); ++r) {
     const double violation = std::max({0.0, gl[r] - g[r], g[r] - gu[r]});
-    double& kind = v.byKind[static_cast<std::size_t>(rowKind(r))];
+    const std::string_view name = rowKind(r);
+    double& kind = std::find_if(v.byKind.begin(), v.byKind.end(), [&](const auto& k) { return k.first == name; })->second;
     kind = std::max(kind, violation);
     if (violation > v.overall) v.overall = violation, v.worstRow = r;
   }

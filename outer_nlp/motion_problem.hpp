@@ -52,6 +52,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "core/bspline.hpp"
@@ -62,17 +64,12 @@
 #include "outer_nlp/derivative_stencil.hpp"
 #include "outer_nlp/nlp_problem.hpp"
 #include "outer_nlp/scenario.hpp"
+#include "outer_nlp/constraint_term.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
+#include "outer_nlp/sample_outputs.hpp"
 #include "outer_nlp/task.hpp"
 
 namespace mcopt {
-
-enum class ConstraintKind {
-  VelocityLimit, TorqueLimit, ContactUnilateral, ContactFriction, ContactCop, ContactYaw, InnerFeasibility, Closure, Task,
-  Epigraph, ClosingJointLimit
-};
-inline constexpr int kConstraintKindCount = 11;
-const char* constraintKindName(ConstraintKind kind);
 
 class BilevelSample;
 struct MotionWorkspace;  // outer_nlp/motion_workspace.hpp
@@ -169,7 +166,16 @@ class MotionProblem final : public NlpProblem {
   int jacobianNonZeros() const { return static_cast<int>(jacobianRows_.size()); }
   const Eigen::VectorXi& jacobianRows() const override { return jacobianRows_; }
   const Eigen::VectorXi& jacobianColumns() const override { return jacobianColumns_; }
-  ConstraintKind rowKind(int row) const { return rows_[static_cast<std::size_t>(row)].kind; }
+  /// The constraint terms (constraint_term.hpp), in the registry's order, and every kind of row
+  /// they can lay out (result.json's `violation_by_kind` keys), rows or not in this problem.
+  const ConstraintTerms& terms() const { return terms_; }
+  std::vector<ConstraintKindInfo> rowKinds() const;
+  /// A row's kind ("torque_limit", …: rowKinds()) and the term that laid it out.
+  const ConstraintKindInfo& rowKindInfo(int row) const {
+    const Row& r = rows_[static_cast<std::size_t>(row)];
+    return terms_[static_cast<std::size_t>(r.term)]->kind(r.detail, r.block);
+  }
+  std::string_view rowKind(int row) const { return rowKindInfo(row).name; }
   /// e.g. "torque limit of LLEG_JOINT3 at sample 12": rowSubject and where it is evaluated.
   std::string rowName(int row) const override;
   /// What a row bounds, without its instant: "torque limit of LLEG_JOINT3", "r_hand friction
@@ -244,8 +250,11 @@ class MotionProblem final : public NlpProblem {
   /// (variable bounds count as "position limit").
   struct Violations {
     double overall = 0.0, positionLimit = 0.0;
-    std::array<double, kConstraintKindCount> byKind{};
+    /// Per kind of row (rowKinds(), in its order; 0 where the problem has none of that kind).
+    std::vector<std::pair<std::string, double>> byKind;
     int worstRow = -1;  ///< -1 when a variable bound is the worst
+    /// The largest violation of one kind; throws std::out_of_range for a kind no term lays out.
+    double of(std::string_view kind) const;
   };
   Violations violations(const Eigen::VectorXd& x);
 
@@ -261,29 +270,10 @@ class MotionProblem final : public NlpProblem {
   /// The motion's physics at the samples (and closure drift at the scenario's output samples).
   SampledPhysics sampledPhysics(const Eigen::VectorXd& x);
 
-  /// Output index of each per-sample quantity (rows of a sample's evaluation).
-  struct SampleOutputs {
-    int joints = 0, contacts = 0;  ///< n, environment contacts
-    /// Admissibility rows (contact_admissibility.hpp): the reference contact's from 0, environment
-    /// contact i's from contactRowStart[1 + i], each as many as its contact model has; contacts + 2 values.
-    std::vector<int> contactRowStart{0, 6};
-    int contactRowCount(int c) const {  ///< c = 0: the reference contact; 1 + i: environment contact i
-      return contactRowStart[static_cast<std::size_t>(c) + 1] - contactRowStart[static_cast<std::size_t>(c)];
-    }
-    int torque(int j) const { return j; }
-    int referenceRow(int c) const { return joints + c; }
-    int contactRow(int contact, int c) const { return joints + contactRowStart[static_cast<std::size_t>(contact) + 1] + c; }
-    int infeasibility() const { return joints + contactRowStart.back(); }
-    int power(int j) const { return infeasibility() + 1 + j; }
-    int closing = 0;  ///< joints that close an environment contact (closed_chains.hpp)
-    int closingPosition(int k) const { return power(joints) + k; }
-    int closingVelocity(int k) const { return power(joints) + closing + k; }
-    int size() const { return power(joints) + 2 * closing; }
-  };
 
  private:
   struct SampleBlock {
-    Eigen::VectorXd y;             ///< outputs, SampleOutputs order
+    Eigen::VectorXd y;             ///< outputs, SampleOutputs order (sample_outputs.hpp)
     Eigen::VectorXd velocity;      ///< q̇ (n), for the gauss-newton Hessian's ∇²P
     Eigen::VectorXd acceleration;  ///< q̈ (n), for the regularisation
     Eigen::VectorXd wrenches;      ///< 6 (1 + contacts): each contact's wrench in its frame (zero when inactive)
@@ -317,15 +307,15 @@ class MotionProblem final : public NlpProblem {
     for (int c = 0; c <= outputs_.contacts; ++c) counts.push_back(outputs_.contactRowCount(c));
     return counts;
   }
-  /// A row of the registry: its kind, what `detail` says (joint, contact row, task
-  /// component), the sample / task instant / velocity row it belongs to, and the output it reads.
+  /// A row of the registry: the term that laid it out (terms_), what `detail` says to that
+  /// term (joint, contact row, task component…), the sample or task instant it belongs to (−1:
+  /// the control points), the output it reads and its own slack variable (−1: none).
   struct Row {
-    ConstraintKind kind;
-    int detail, block, output;
+    int term, detail, block, output, slack;
   };
-  /// Where a Jacobian entry's value comes from.
+  /// Where a Jacobian entry's value comes from (Direct: the term's directDerivative along local column `local`).
   struct JacobianEntry {
-    enum class Source : unsigned char { Parameter, Duration, Force, Slack, VelocityFirst, VelocitySecond, VelocityDuration };
+    enum class Source : unsigned char { Parameter, Duration, Force, Slack, Direct };
     Source source;
     bool task;  ///< a task block rather than a sample block
     int block, output, local;
@@ -453,16 +443,15 @@ class MotionProblem final : public NlpProblem {
   std::vector<bool> unusedParameter_;
   std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
-  std::vector<int> torqueJoints_;         ///< joints with a finite torque limit
+  std::vector<int> torqueJoints_;         ///< joints with a finite torque limit (when limited)
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants
   std::vector<std::vector<int>> taskJoints_;     ///< per task instant: joints that move the task's body
-  struct VelocityRow { int joint, first, second; double scale; };  ///< 3 (x_second − x_first)/(T Δu) → scale = 3/Δu
-  std::vector<VelocityRow> velocityRows_;
   ContactAdmissibilityRows support_;
   double weight_ = 0.0;                   ///< m g [N]
 
+  ConstraintTerms terms_;  ///< the row families (constraint_term.hpp), made once the layout above is known
   std::vector<Row> rows_;
   std::vector<JacobianEntry> entries_;
   Eigen::VectorXi jacobianRows_, jacobianColumns_;

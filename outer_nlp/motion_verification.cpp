@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
+#include <string_view>
 
 #include "core/dynamics_data.hpp"
 #include "core/inverse_dynamics.hpp"
@@ -50,17 +52,6 @@ class CheckBuilder {
   std::vector<double> failing_;
 };
 
-const char* unitOf(ConstraintKind kind) {
-  switch (kind) {
-    case ConstraintKind::VelocityLimit: return "rad/s";
-    case ConstraintKind::TorqueLimit: return "N m";
-    case ConstraintKind::InnerFeasibility: return "(slack / m g)^2";
-    case ConstraintKind::Closure:
-    case ConstraintKind::Task: return "task units (m, m/s, rad)";
-    case ConstraintKind::ClosingJointLimit: return "rad, rad/s";
-    default: return "contact row units (contact model)";
-  }
-}
 
 }  // namespace
 
@@ -107,17 +98,15 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   fine.constraints(xf, g);
   fine.constraintBounds(lower, upper);
   std::vector<CheckBuilder> rowChecks;
-  std::vector<int> builderOf(kConstraintKindCount, -1);
+  std::map<std::string_view, std::size_t> builderOf;
   for (int r = 0; r < fine.constraintCount(); ++r) {
-    const ConstraintKind kind = fine.rowKind(r);
-    if (kind == ConstraintKind::Epigraph) continue;
-    int& b = builderOf[static_cast<std::size_t>(kind)];
-    if (b < 0) {
-      b = static_cast<int>(rowChecks.size());
-      rowChecks.emplace_back(constraintKindName(kind), unitOf(kind), tol);
-    }
+    const ConstraintKindInfo& kind = fine.rowKindInfo(r);
+    if (!kind.verified) continue;
+    const auto [found, added] = builderOf.try_emplace(kind.name, rowChecks.size());
+    if (added) rowChecks.emplace_back(std::string(kind.name), std::string(kind.unit), tol);
+    const std::size_t b = found->second;
     const double violation = std::isnan(g[r]) ? g[r] : std::max({0.0, lower[r] - g[r], g[r] - upper[r]});
-    rowChecks[static_cast<std::size_t>(b)].add(violation, fine.rowSubject(r), fine.rowTime(r, T));
+    rowChecks[b].add(violation, fine.rowSubject(r), fine.rowTime(r, T));
   }
   for (CheckBuilder& b : rowChecks) v.checks.push_back(b.finish(sampleTimes));
 

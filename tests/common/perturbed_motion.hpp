@@ -27,7 +27,7 @@ inline Eigen::VectorXd perturbedMotion(MotionProblem& problem, double size, unsi
 inline Eigen::VectorXd withWindowEndsMet(MotionProblem& problem, Eigen::VectorXd x) {
   std::vector<int> rows;
   for (int r = 0; r < problem.constraintCount(); ++r)
-    if (problem.rowKind(r) == ConstraintKind::Closure) rows.push_back(r);
+    if (problem.rowKind(r) == "closure") rows.push_back(r);
   if (rows.empty()) return x;
   Eigen::VectorXd lower, upper, g;
   problem.constraintBounds(lower, upper);

@@ -138,12 +138,12 @@ Eigen::MatrixXd gaussNewtonReference(MotionProblem& problem, Eigen::VectorXd x, 
   const Eigen::MatrixXd dv = dStates.topRows(n * N), da = dStates.bottomRows(n * N);
   std::vector<int> torqueRow(static_cast<std::size_t>(n * N), -1), epigraphRow(static_cast<std::size_t>(n * N), -1);
   for (int r = 0; r < problem.constraintCount(); ++r) {
-    if (problem.rowKind(r) != ConstraintKind::TorqueLimit && problem.rowKind(r) != ConstraintKind::Epigraph) continue;
+    if (problem.rowKind(r) != "torque_limit" && problem.rowKind(r) != "energy_epigraph") continue;
     const std::string name = problem.rowName(r);  // "torque limit of J at sample S", "energy epigraph of J at sample S"
     const std::size_t of = name.find(" of ") + 4, at = name.find(" at sample ");
     const int joint = s.robot.findJoint(name.substr(of, at - of)), sample = std::stoi(name.substr(at + 11));
     REQUIRE(joint >= 0);
-    (problem.rowKind(r) == ConstraintKind::TorqueLimit ? torqueRow : epigraphRow)[static_cast<std::size_t>(sample * n + joint)] = r;
+    (problem.rowKind(r) == "torque_limit" ? torqueRow : epigraphRow)[static_cast<std::size_t>(sample * n + joint)] = r;
   }
   const bool smooth = s.energyForm == EnergyForm::SmoothMaximum;
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(curved, curved);
@@ -205,7 +205,7 @@ TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jaco
     Eigen::VectorXd lambda = Eigen::VectorXd::Zero(problem.constraintCount());
     const Eigen::VectorXd random = randomMultipliers(problem, 19);
     for (int r = 0; r < problem.constraintCount(); ++r)
-      if (problem.rowKind(r) == ConstraintKind::Epigraph) lambda[r] = random[r];
+      if (problem.rowKind(r) == "energy_epigraph") lambda[r] = random[r];
     const double sigma = c.epigraph ? 0.0 : 0.8;
     Eigen::VectorXd values;
     problem.lagrangianHessian(x, sigma, lambda, values);

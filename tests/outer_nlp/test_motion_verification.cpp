@@ -50,15 +50,19 @@ TEST_CASE("verify: with one instant an interval, the rows it checks are the prob
   const MotionVerification v = verifyMotion(problem, x, settings);
   CHECK(v.instants == s.samples);
   const MotionProblem::Violations sampled = problem.violations(x);
-  for (int k = 0; k < kConstraintKindCount; ++k) {
-    const auto kind = static_cast<ConstraintKind>(k);
-    if (kind == ConstraintKind::Epigraph) continue;
+  std::vector<std::string> compared;
+  for (const ConstraintKindInfo& kind : problem.rowKinds()) {
+    if (!kind.verified) continue;
     for (const VerificationCheck& c : v.checks)
-      if (c.kind == constraintKindName(kind)) {
+      if (c.kind == kind.name) {
         INFO(c.kind);
-        CHECK(c.worst == Approx(sampled.byKind[static_cast<std::size_t>(k)]).margin(1e-12));
+        CHECK(c.worst == Approx(sampled.of(kind.name)).margin(1e-12));
+        compared.push_back(c.kind);
       }
   }
+  // The kick's rows: velocity and torque limits, its reference contact's and its task's.
+  for (const char* kind : {"velocity_limit", "torque_limit", "contact_unilateral", "task"})
+    CHECK(std::count(compared.begin(), compared.end(), kind) == 1);
 }
 
 TEST_CASE("verify: a spline parameter nudged so that a torque limit breaks between two samples only", "[outer][verify]") {
@@ -120,7 +124,7 @@ TEST_CASE("verify: a spline parameter nudged so that a torque limit breaks betwe
   const std::string joint = s.robot.joints[static_cast<std::size_t>(plantedJoint)].name;
   INFO("planted on " << joint);
   // The problem's rows at the samples see nothing wrong with the torques.
-  CHECK(problem.violations(*planted).byKind[static_cast<std::size_t>(ConstraintKind::TorqueLimit)] == 0.0);
+  CHECK(problem.violations(*planted).of("torque_limit") == 0.0);
   const MotionVerification v = verifyMotion(problem, *planted);
   const VerificationCheck& torque = checkOf(v, "torque_limit");
   CHECK_FALSE(torque.passed());

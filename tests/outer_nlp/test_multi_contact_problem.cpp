@@ -144,7 +144,7 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
   std::vector<int> rows;
   int positive = 0;
   for (int r = 0; r < problem.constraintCount(); ++r)
-    if (problem.rowKind(r) == ConstraintKind::InnerFeasibility) rows.push_back(r), positive += g[r] > 0.0;
+    if (problem.rowKind(r) == "inner_feasibility") rows.push_back(r), positive += g[r] > 0.0;
   CHECK(positive == infeasible);
   const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
   const Eigen::MatrixXd fd = test::centralDifferences(x, 1e-6, [&] {
@@ -274,8 +274,8 @@ TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios eval
       // as rows, no closure rows); the lean reach's hand over its window by a band of rows.
       int closureRows = 0, closingRows = 0;
       for (int r = 0; r < problem.constraintCount(); ++r) {
-        closureRows += problem.rowKind(r) == ConstraintKind::Closure;
-        closingRows += problem.rowKind(r) == ConstraintKind::ClosingJointLimit;
+        closureRows += problem.rowKind(r) == "closure";
+        closingRows += problem.rowKind(r) == "closing_joint_limit";
       }
       REQUIRE(problem.closedChains() != nullptr);
       CHECK(problem.closedChains()->contacts().front().name == "r_sole");
