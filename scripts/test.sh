@@ -1,12 +1,18 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: BSD-3-Clause
-# Installs the dependencies, then builds and runs the whole test suite twice:
-# Release with warnings as errors, and AddressSanitizer + UndefinedBehaviorSanitizer.
-# Both suites replay every fuzz seed and regression input through the fuzz targets' code. With
-# MCOPT_FUZZ_SECONDS > 0, each libFuzzer target then runs that long (scripts/fuzz.sh,
-# docs/developers/fuzzing.md); CI leaves it at 0: the clang fuzz build took five to six minutes
-# of a 45-minute budget (docs/developers/lab-notes/ci-budget.md). Set MCOPT_SKIP_SANITIZE=1 to
-# run only the first suite.
+# Installs the dependencies, builds and runs the whole test suite in Release with warnings as
+# errors, then runs part of it again under AddressSanitizer + UndefinedBehaviorSanitizer.
+# MCOPT_SANITIZE says which part (docs/developers/index.md, "The CI budget"):
+#   libraries  (the default, CI's) the tests of core, inner_qp, sensitivity and outer_nlp: every
+#              library an optimisation runs through, the kernels and the NLP, without the
+#              commands' whole runs;
+#   all        every test of the sanitizer tree: also the command-line tests (whole optimisations
+#              through `mcopt`) and the fuzz seeds and regression inputs, replayed through the fuzz
+#              targets' code (the Release suite replays them too);
+#   none       the Release suite alone (MCOPT_SKIP_SANITIZE=1 says the same).
+# The whole sanitizer suite took 37 minutes on its own (build 27 min, tests 10 min, at 8d1c23b:
+# docs/developers/lab-notes/ci-budget.md). With MCOPT_FUZZ_SECONDS > 0, each libFuzzer target
+# then runs that long (scripts/fuzz.sh, docs/developers/fuzzing.md); CI leaves it at 0.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"
@@ -16,11 +22,21 @@ cmake --preset release -S "$root"
 cmake --build "$root/build/release" --parallel "$jobs"
 (cd "$root/build/release" && ctest --output-on-failure --parallel "$jobs")
 
-if [ "${MCOPT_SKIP_SANITIZE:-0}" != "1" ]; then
+sanitize="${MCOPT_SANITIZE:-libraries}"
+[ "${MCOPT_SKIP_SANITIZE:-0}" != "1" ] || sanitize=none
+case "$sanitize" in
+  libraries)
+    targets=(mcopt-tests-core mcopt-tests-inner mcopt-tests-sensitivity mcopt-tests-outer)
+    tests='^mcopt-tests-(core|inner|sensitivity|outer):' ;;
+  all) targets=(all); tests='' ;;
+  none) targets=() ;;
+  *) echo "scripts/test.sh: MCOPT_SANITIZE=$sanitize: expected libraries, all or none" >&2; exit 2 ;;
+esac
+if [ "${#targets[@]}" -gt 0 ]; then
   cmake --preset sanitize -S "$root"
-  cmake --build "$root/build/sanitize" --parallel "$jobs"
+  cmake --build "$root/build/sanitize" --parallel "$jobs" --target "${targets[@]}"
   (cd "$root/build/sanitize" && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-     ctest --output-on-failure --parallel "$jobs")
+     ctest --output-on-failure --parallel "$jobs" ${tests:+--tests-regex "$tests"})
 fi
 
 fuzz_seconds="${MCOPT_FUZZ_SECONDS:-0}"
