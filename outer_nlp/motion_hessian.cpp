@@ -38,7 +38,6 @@
 #include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "outer_nlp/smooth_maximum.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
@@ -59,18 +58,26 @@ void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objective
     NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
 }
 
-void MotionProblem::sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+void MotionProblem::sampleLagrangianGradient(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                              double objectiveWeight, HessianWorkspace& h,
                                              Eigen::Ref<Eigen::VectorXd> gradient) const {
-  const int n = jointCount_;
+  // The rows' multipliers and the cost terms' slopes on the outputs, then the terms that read
+  // the state directly (the regularisation w Σ q̈², formulation.md §10).
+  const CostSample sample = costSample(s, b);
   h.weights = multipliers;
-  if (scenario_.energyForm == EnergyForm::SmoothMaximum)
-    for (int j = 0; j < n; ++j)
-      h.weights[outputs_.power(j)] += objectiveWeight * smoothMaximumSlope(b.y[outputs_.power(j)], scenario_.smoothing);
+  for (const auto& term : costs_) term->addOutputSlopes(sample, objectiveWeight, h.weights);
   outputGradient(b, h.weights, gradient);
-  // The regularisation w Σ q̈² over the spline joints (formulation.md §10).
-  for (int j = 0; j < n; ++j)
-    if (!closure_ || !closure_->closesIn(j, b.closed)) gradient[2 * n + j] += 2.0 * objectiveWeight * scenario_.accelerationWeight * b.acceleration[j];
+  for (const auto& term : costs_) term->addStateGradient(sample, objectiveWeight, gradient);
+}
+
+void MotionProblem::costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h,
+                                      bool curvatures) const {
+  const CostSample sample = costSample(s, b);
+  h.costSlopes.setZero();
+  for (const auto& term : costs_) term->addOutputSlopes(sample, objectiveWeight, h.costSlopes);
+  if (!curvatures) return;
+  h.costCurvatures.setZero();
+  for (const auto& term : costs_) term->addOutputCurvatures(sample, objectiveWeight, h.costCurvatures);
 }
 
 void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights,
@@ -100,7 +107,7 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
                                        SampleBlock& probe) {
   const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
   // The energy's and the epigraph's curvature in the outputs (P in Γ, q̇, q̈; σ in P) ...
-  sampleGaussNewtonHessian(b, multipliers, objectiveWeight, h);
+  sampleGaussNewtonHessian(s, b, multipliers, objectiveWeight, h);
   auto H = h.stateHessian.topLeftCorner(d, d);
   // ... the report model's friction-cone rows r(W), quadratic in the wrench: their
   // curvature λ_cone J_Wᵀ ∇²r J_W exactly, and their weights moved onto the wrench — ω =
@@ -130,12 +137,10 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
   }
   // ... and the outputs' own: each output's weight at this point is its multiplier, plus on
   // Γ_j the power's slope times ∂P/∂Γ (P's own curvature is in the terms above).
-  const bool smooth = scenario_.energyForm == EnergyForm::SmoothMaximum;
+  costOutputWeights(s, b, objectiveWeight, h, false);
   h.fixedWeights = multipliers;
   for (int j = 0; j < n; ++j) {
-    const double P = b.y[outputs_.power(j)];
-    const double slope =
-        multipliers[outputs_.power(j)] + (smooth ? objectiveWeight * smoothMaximumSlope(P, scenario_.smoothing) : 0.0);
+    const double slope = multipliers[outputs_.power(j)] + h.costSlopes[outputs_.power(j)];
     const MotorPowerDerivatives p =
         motorPowerDerivatives(scenario_.actuators.joints[static_cast<std::size_t>(j)], scenario_.actuators.frictionSharpness,
                               b.y[outputs_.torque(j)], b.velocity[j], b.acceleration[j]);
@@ -177,7 +182,7 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
   }
 }
 
-void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+void MotionProblem::sampleGaussNewtonHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                              double objectiveWeight, HessianWorkspace& h) const {
   // The sample's terms are functions of its outputs: c σ(P_j) (smooth maximum) or λ_P P_j
   // (epigraph) per joint, P_j = P(Γ_j, q̇_j, q̈_j) (core/actuators.hpp), and c w q̈² for the
@@ -191,7 +196,7 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
   const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
   auto H = h.stateHessian.topLeftCorner(d, d);
   H.setZero();
-  const bool smooth = scenario_.energyForm == EnergyForm::SmoothMaximum;
+  costOutputWeights(s, b, objectiveWeight, h, true);
   auto gradientOf = [&](int output, Eigen::Ref<Eigen::VectorXd> row) {
     row.segment(0, n) = b.dyDq.row(output).transpose();
     row.segment(n, n) = b.dyDv.row(output).transpose();
@@ -200,10 +205,8 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
   };
   auto torqueGradient = h.base.head(d), powerGradient = h.gradient.head(d);
   for (int j = 0; j < n; ++j) {
-    const double P = b.y[outputs_.power(j)];
-    const double slope =
-        multipliers[outputs_.power(j)] + (smooth ? objectiveWeight * smoothMaximumSlope(P, scenario_.smoothing) : 0.0);
-    const double curvature = smooth ? objectiveWeight * smoothMaximumCurvature(P, scenario_.smoothing) : 0.0;
+    const double slope = multipliers[outputs_.power(j)] + h.costSlopes[outputs_.power(j)];
+    const double curvature = h.costCurvatures[outputs_.power(j)];
     if (curvature != 0.0) {
       gradientOf(outputs_.power(j), powerGradient);
       H.selfadjointView<Eigen::Lower>().rankUpdate(powerGradient, curvature);
@@ -226,8 +229,8 @@ void MotionProblem::sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::
     H(a, v) += M(1, 2);
     H(a, a) += M(2, 2);
   }
-  for (int j = 0; j < n; ++j)
-    if (!closure_ || !closure_->closesIn(j, b.closed)) H(2 * n + j, 2 * n + j) += 2.0 * objectiveWeight * scenario_.accelerationWeight;
+  const CostSample sample = costSample(s, b);
+  for (const auto& term : costs_) term->addStateHessian(sample, objectiveWeight, H);
   H.triangularView<Eigen::StrictlyUpper>() = H.transpose();  // the spreading reads the whole matrix
 }
 
@@ -264,6 +267,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     const int largest = 3 * n + static_cast<int>(forceColumns), largestLocal = 4 * n + static_cast<int>(forceColumns);
     for (HessianWorkspace& h : hessianWorkspaces_) {
       h.weights.setZero(outputs), h.base.setZero(largest), h.gradient.setZero(largest);
+      h.costSlopes.setZero(outputs), h.costCurvatures.setZero(outputs);
       h.stateHessian.setZero(largest, largest), h.spread.setZero(largest, largestLocal);
       h.fixedWeights.setZero(outputs), h.zeroWeights.setZero(outputs), h.column.setZero(largest);
       h.centreGradient.setZero(largest);
@@ -388,7 +392,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const double objectiveWeight = objectiveFactor * sampleWeights_[static_cast<std::size_t>(s)] * T;
       const auto lambda = sampleMultipliers_.col(s);
       if (scenario_.hessian == HessianOption::GaussNewton) {
-        sampleGaussNewtonHessian(b, lambda, objectiveWeight, h);
+        sampleGaussNewtonHessian(s, b, lambda, objectiveWeight, h);
         spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, closure_ ? &b.closureMap : nullptr, b.closed);
         continue;
       }
@@ -399,8 +403,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           // The chain rule through z_s(x, T) and the objective's weight c T (file comment).
           const auto H = h.stateHessian.topLeftCorner(d, d);
           auto g = h.base.head(d), cE = h.objectiveGradient.head(d), u = h.stateByDuration.head(d), dz = h.durationRow.head(d);
-          sampleLagrangianGradient(b, lambda, objectiveWeight, h, g);
-          sampleLagrangianGradient(b, h.zeroWeights, objectiveWeight / T, h, cE);
+          sampleLagrangianGradient(s, b, lambda, objectiveWeight, h, g);
+          sampleLagrangianGradient(s, b, h.zeroWeights, objectiveWeight / T, h, cE);
           u.setZero();
           u.segment(n, n) = -b.velocity / T;
           u.segment(2 * n, n) = -2.0 / T * b.acceleration;
@@ -415,7 +419,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         continue;
       }
       auto base = h.base.head(d), gradient = h.gradient.head(d);
-      sampleLagrangianGradient(b, lambda, objectiveWeight, h, base);
+      sampleLagrangianGradient(s, b, lambda, objectiveWeight, h, base);
       samples_.evaluate(s, controlPoints_, T, w.q, w.v, w.a);
       closeState(b, w, nullptr);  // the sample's own state
       // Closed chains: differences in the spline joints' state, each probe closed again (the
@@ -441,7 +445,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         sampleOutputs(s, h.probeX, true, w, probe);
         *component = saved;
         if (closure_ && state) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
-        sampleLagrangianGradient(probe, lambda, objectiveWeight, h, gradient);
+        sampleLagrangianGradient(s, probe, lambda, objectiveWeight, h, gradient);
         if (closure_) foldGradient(state ? h.probeMap : b.closureMap, b.closed, 3, gradient.head(3 * n));
         h.stateHessian.col(c).head(d) = (gradient - base) / step;
       }

@@ -21,7 +21,6 @@
 #include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/ballistic_flight.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "outer_nlp/smooth_maximum.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
@@ -303,6 +302,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
   terms_ = makeConstraintTerms(TermContext{scenario_, parametrization_, outputs_, closure_.get(), support_, contactRows_, bilevel_,
                                            relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_,
                                            taskOfInstant_});
+  costs_ = makeCostTerms(CostContext{scenario_, outputs_, closure_.get(), parametrization_, samples_, slackStart_});
   buildStructure();
 }
 
@@ -1013,66 +1013,34 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
 
 double MotionProblem::objective(const Eigen::VectorXd& x) {
   evaluate(x, false);
-  const int N = samples_.sampleCount(), n = jointCount_;
+  const int N = samples_.sampleCount();
   const double T = duration(x);
   double energy = 0.0;
   for (int s = 0; s < N; ++s) {
     const double weight = sampleWeights_[static_cast<std::size_t>(s)] * T;
+    const CostSample sample = costSample(s, blocks_[static_cast<std::size_t>(s)]);
     double sum = 0.0;
-    if (scenario_.energyForm == EnergyForm::Epigraph)
-      sum = x.segment(slackIndex(s, 0), n).sum();
-    else
-      for (int j = 0; j < n; ++j)
-        sum += smoothMaximum(blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)], scenario_.smoothing);
-    if (scenario_.accelerationWeight > 0.0)
-      for (int j = 0; j < n; ++j)  // the spline joints' (a closed joint's follows the closure)
-        if (!closure_ || !closure_->closesIn(j, blocks_[static_cast<std::size_t>(s)].closed))
-          sum += scenario_.accelerationWeight * blocks_[static_cast<std::size_t>(s)].acceleration[j] * blocks_[static_cast<std::size_t>(s)].acceleration[j];
+    for (const auto& term : costs_) term->addValue(sample, x, sum);
     energy += weight * sum;
   }
   return energy;
 }
 
 void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) {
-  const bool epigraph = scenario_.energyForm == EnergyForm::Epigraph;
-  if (!epigraph)
+  CostNeeds needs = CostNeeds::Nothing;
+  for (const auto& term : costs_) needs = std::max(needs, term->needs());
+  if (needs == CostNeeds::Derivatives)
     evaluate(x, true);
-  else if (scenario_.accelerationWeight > 0.0)
+  else if (needs == CostNeeds::Values)
     evaluate(x, false);
-  const int N = samples_.sampleCount(), n = jointCount_;
+  const int N = samples_.sampleCount();
   const double T = duration(x);
   gradient.setZero(variableCount_);
   double dT = 0.0;
   for (int s = 0; s < N; ++s) {
     const double weight = sampleWeights_[static_cast<std::size_t>(s)] * T;
-    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-    if (scenario_.accelerationWeight > 0.0) {
-      // ∂q̈_j/∂x_{j,l} = w''_l / T², ∂q̈/∂T = −2 q̈ / T; the weight Δt ∝ T.
-      const LocalParameterWeights& local = samples_.weights(s);
-      const double scale = weight * scenario_.accelerationWeight;
-      const int m = parametrization_.parametersPerJoint();
-      double squared = 0.0;
-      for (int j = 0; j < n; ++j) {
-        if (closure_ && closure_->closesIn(j, b.closed)) continue;
-        squared += b.acceleration[j] * b.acceleration[j];
-        for (int l = 0; l < local.count; ++l)
-          gradient[j * m + local.parameter[l]] += scale * 2.0 * b.acceleration[j] * local.d2[l] / (T * T);
-      }
-      dT += scale * (squared / T - 4.0 * squared / T);
-    }
-    if (epigraph) {
-      gradient.segment(slackIndex(s, 0), n).array() += weight;
-      dT += weight / T * x.segment(slackIndex(s, 0), n).sum();
-      continue;
-    }
-    for (int j = 0; j < n; ++j) {
-      const int row = outputs_.power(j);
-      const double p = b.y[row], slope = weight * smoothMaximumSlope(p, scenario_.smoothing);
-      for (Eigen::Index c = 0; c < b.parameters.size(); ++c) gradient[b.parameters[c]] += slope * b.dyDx(row, c);
-      for (std::size_t c = 0; c < b.forceColumns.size(); ++c)
-        gradient[b.forceColumns[c]] += slope * b.dyDz(row, static_cast<Eigen::Index>(c));
-      dT += slope * b.dyDT[row] + weight / T * smoothMaximum(p, scenario_.smoothing);
-    }
+    const CostSample sample = costSample(s, blocks_[static_cast<std::size_t>(s)]);
+    for (const auto& term : costs_) term->addGradient(sample, x, weight, T, gradient, dT);
   }
   if (durationIsFree()) gradient[parameterCount_] = dT;
 }

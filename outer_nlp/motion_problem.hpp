@@ -66,6 +66,7 @@
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/constraint_term.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
+#include "outer_nlp/cost_term.hpp"
 #include "outer_nlp/sample_outputs.hpp"
 #include "outer_nlp/task.hpp"
 
@@ -169,6 +170,8 @@ class MotionProblem final : public NlpProblem {
   /// The constraint terms (constraint_term.hpp), in the registry's order, and every kind of row
   /// they can lay out (result.json's `violation_by_kind` keys), rows or not in this problem.
   const ConstraintTerms& terms() const { return terms_; }
+  /// The objective's terms (cost_term.hpp), in the order a sample's integrand sums them.
+  const CostTerms& costs() const { return costs_; }
   std::vector<ConstraintKindInfo> rowKinds() const;
   /// A row's kind ("torque_limit", …: rowKinds()) and the term that laid it out.
   const ConstraintKindInfo& rowKindInfo(int row) const {
@@ -357,6 +360,7 @@ class MotionProblem final : public NlpProblem {
   /// Per-thread buffers of the sample-differences Hessian (motion_hessian.cpp).
   struct HessianWorkspace {
     Eigen::VectorXd probeX, weights, base, gradient;
+    Eigen::VectorXd costSlopes, costCurvatures;  ///< the cost terms' slopes and curvatures in the outputs
     Eigen::MatrixXd stateHessian, spread;
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen;
     // The exact option: outputs' weights held at the sample's point, a column being summed,
@@ -396,12 +400,19 @@ class MotionProblem final : public NlpProblem {
                                 const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values);
   /// ∇ of one sample's Lagrangian terms in its state (q, q̇, q̈) and force columns, from the
   /// outputs' derivatives in `b` and each output's multiplier (+ the objective's share).
-  void sampleLagrangianGradient(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+  void sampleLagrangianGradient(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// The gauss-newton option's H_s (HessianOption::GaussNewton) into h.stateHessian, from the
   /// sample's state, outputs and derivatives in `b`.
-  void sampleGaussNewtonHessian(const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+  void sampleGaussNewtonHessian(int s, const SampleBlock& b, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                 double objectiveWeight, HessianWorkspace& h) const;
+  /// Sample s as the cost terms see it, from block b (its own, or a Hessian probe at its state).
+  CostSample costSample(int s, const SampleBlock& b) const {
+    return CostSample{s, b.y, b.acceleration, b.closed, b.dyDx, b.dyDT, b.dyDz, b.parameters, b.forceColumns};
+  }
+  /// The cost terms' slopes (and with `curvatures` their curvatures) in sample s's outputs at
+  /// b, times objectiveWeight, into h.costSlopes (h.costCurvatures).
+  void costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h, bool curvatures) const;
   /// Σ_o weights_o ∇y_o in the state (q, q̇, q̈) and force columns of `b`, weights held fixed.
   void outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// ∂W_ref/∂(state, force columns) at the point sampleOutputs last evaluated in `w`, 6 × d.
@@ -452,6 +463,7 @@ class MotionProblem final : public NlpProblem {
   double weight_ = 0.0;                   ///< m g [N]
 
   ConstraintTerms terms_;  ///< the row families (constraint_term.hpp), made once the layout above is known
+  CostTerms costs_;        ///< the objective's terms (cost_term.hpp)
   std::vector<Row> rows_;
   std::vector<JacobianEntry> entries_;
   Eigen::VectorXi jacobianRows_, jacobianColumns_;

@@ -2,12 +2,14 @@
 // The outer rows as constraint terms (outer_nlp/constraint_term.hpp): every row's kind is one
 // its term registers, every registered kind is laid out by some bundled scenario and documented
 // (docs/reference/results.md, `violation_by_kind`), the rows of a sample follow the registry's
-// order, and a row's bounds, name and value are its term's.
+// order, and a row's bounds, name and value are its term's. The objective as cost terms
+// (outer_nlp/cost_term.hpp): each energy form and the regularisation against the sampled motion.
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <random>
 #include <regex>
 #include <set>
 #include <string>
@@ -144,6 +146,56 @@ TEST_CASE("constraint terms: a sample's rows follow the registry's order, and ea
       }
       lastPlace = place, lastTerm = t;
     }
+  }
+}
+
+}  // namespace mcopt
+
+namespace mcopt {
+
+TEST_CASE("cost terms: each energy form's objective is the sampled energy, and the regularisation adds w ∫ Σ q̈² dt",
+          "[outer][terms]") {
+  // Against the motion's own samples (sampledPhysics: P and q̈ at each sample, max(P, 0)
+  // integrated by the trapezoid rule), not against the terms' code.
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
+  s.samples = 15, s.torqueScreening = 0.0;
+  const auto integrate = [](const MotionProblem& problem, double T, const auto& integrand) {
+    double sum = 0.0;
+    for (int k = 0; k < problem.sampleCount(); ++k) sum += problem.sampleWeight(k) * T * integrand(k);
+    return sum;
+  };
+  for (const EnergyForm form : {EnergyForm::SmoothMaximum, EnergyForm::Epigraph}) {
+    s.energyForm = form, s.accelerationWeight = 0.0;
+    MotionProblem plain(s);
+    // A motion that moves (the kick's start and end postures are the same), the epigraph's
+    // slacks at max(P, 0) of it.
+    const Eigen::VectorXd start = plain.initialPoint(s.start, s.end);
+    std::mt19937 rng(7);
+    const Eigen::VectorXd motion =
+        plain.motionParameters(start) + test::randomVector(rng, static_cast<int>(plain.motionParameters(start).size()), 0.05);
+    const Eigen::VectorXd x = plain.pointFromMotion(motion, plain.duration(start));
+    const SampledPhysics physics = plain.sampledPhysics(x);
+    const double T = plain.duration(x);
+    REQUIRE(plain.costs().size() == 2);
+    CHECK(plain.costs()[0]->name() == (form == EnergyForm::Epigraph ? "energy (epigraph)" : "energy (smooth maximum)"));
+    CHECK(plain.costs()[1]->name() == "acceleration regularisation");
+    const double E = plain.objective(x);
+    if (form == EnergyForm::Epigraph) {
+      CHECK(E == Approx(physics.energy).epsilon(1e-12));
+    } else {
+      // σ(P) − max(P, 0) lies in (0, ε/2]: the smooth maximum is above the energy by at most
+      // ε/2 per joint and instant.
+      const double gap = E - physics.energy;
+      CHECK(gap > 0.0);
+      CHECK(gap <= integrate(plain, T, [&](int) { return 0.5 * s.smoothing * s.robot.jointCount(); }) * (1.0 + 1e-12));
+    }
+    // The regularisation: w Σ_s c_s T Σ_j q̈_js² on top, whatever the energy form.
+    s.accelerationWeight = 1e-3;
+    MotionProblem regularised(s);
+    const double added = integrate(regularised, T, [&](int k) { return s.accelerationWeight * physics.a.col(k).squaredNorm(); });
+    INFO((form == EnergyForm::Epigraph ? "epigraph" : "smooth maximum"));
+    CHECK(added > 0.0);
+    CHECK(regularised.objective(x) - E == Approx(added).epsilon(1e-9));
   }
 }
 
