@@ -10,7 +10,6 @@
 #include <fstream>
 #include <map>
 #include <random>
-#include <regex>
 #include <set>
 #include <string>
 
@@ -54,10 +53,14 @@ std::set<std::string> documentedKinds() {
   while (std::getline(file, line)) {
     if (line.rfind("### ", 0) == 0) inSection = line == "### `violation_by_kind`";
     if (!inSection || line.rfind("| `", 0) != 0) continue;
+    // The first cell's words in backquotes.
     const std::string first = line.substr(1, line.find('|', 1) - 1);
-    const std::regex key("`([a-z_]+)`");
-    for (auto it = std::sregex_iterator(first.begin(), first.end(), key); it != std::sregex_iterator(); ++it)
-      keys.insert((*it)[1]);
+    for (std::size_t open = first.find('`'); open != std::string::npos; open = first.find('`', open)) {
+      const std::size_t close = first.find('`', open + 1);
+      if (close == std::string::npos) break;
+      keys.insert(first.substr(open + 1, close - open - 1));
+      open = close + 1;
+    }
   }
   keys.erase("position_limit");
   return keys;
