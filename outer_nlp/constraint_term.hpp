@@ -117,6 +117,19 @@ class ConstraintTerm {
                                 int /*durationColumn*/, Eigen::MatrixXd& /*hessian*/) const {}
 };
 
+/// A term whose rows are all of one kind and at the samples (torque limits, closing-joint
+/// limits, inner feasibility, the epigraph's rows). `kind` has static storage.
+class SampleTermOfOneKind : public ConstraintTerm {
+ public:
+  explicit SampleTermOfOneKind(const ConstraintKindInfo& kind) : kind_(kind) {}
+  RowPlace place() const override { return RowPlace::Sample; }
+  std::vector<ConstraintKindInfo> kinds() const override { return {kind_}; }
+  const ConstraintKindInfo& kind(int, int) const override { return kind_; }
+
+ private:
+  const ConstraintKindInfo& kind_;
+};
+
 using ConstraintTerms = std::vector<std::unique_ptr<const ConstraintTerm>>;
 
 /// The registry: every term, in the order of the rows within a sample (constraint_term.cpp).

@@ -79,12 +79,9 @@ class ContactAdmissibilityTerm final : public ConstraintTerm {
   TermContext c_;
 };
 
-class InnerFeasibilityTerm final : public ConstraintTerm {
+class InnerFeasibilityTerm final : public SampleTermOfOneKind {
  public:
-  explicit InnerFeasibilityTerm(const TermContext& c) : c_(c) {}
-  RowPlace place() const override { return RowPlace::Sample; }
-  std::vector<ConstraintKindInfo> kinds() const override { return {kInnerFeasibility}; }
-  const ConstraintKindInfo& kind(int, int) const override { return kInnerFeasibility; }
+  explicit InnerFeasibilityTerm(const TermContext& c) : SampleTermOfOneKind(kInnerFeasibility), c_(c) {}
   void appendRows(RowSink& sink) const override {
     if (c_.bilevel) sink.outputRow(0, c_.outputs.infeasibility(), c_.allJoints, false);
   }

@@ -17,12 +17,9 @@ namespace {
 // max(P, 0), they say nothing about the motion (mcopt verify skips them).
 constexpr ConstraintKindInfo kEpigraph{"energy_epigraph", "W", false};
 
-class EnergyEpigraphTerm final : public ConstraintTerm {
+class EnergyEpigraphTerm final : public SampleTermOfOneKind {
  public:
-  explicit EnergyEpigraphTerm(const TermContext& c) : c_(c) {}
-  RowPlace place() const override { return RowPlace::Sample; }
-  std::vector<ConstraintKindInfo> kinds() const override { return {kEpigraph}; }
-  const ConstraintKindInfo& kind(int, int) const override { return kEpigraph; }
+  explicit EnergyEpigraphTerm(const TermContext& c) : SampleTermOfOneKind(kEpigraph), c_(c) {}
   double outputSign() const override { return -1.0; }
   void appendRows(RowSink& sink) const override {
     if (c_.scenario.energyForm != EnergyForm::Epigraph) return;

@@ -92,12 +92,9 @@ class VelocityLimitTerm final : public ConstraintTerm {
   std::vector<Row> rows_;
 };
 
-class TorqueLimitTerm final : public ConstraintTerm {
+class TorqueLimitTerm final : public SampleTermOfOneKind {
  public:
-  explicit TorqueLimitTerm(const TermContext& c) : c_(c) {}
-  RowPlace place() const override { return RowPlace::Sample; }
-  std::vector<ConstraintKindInfo> kinds() const override { return {kTorqueLimit}; }
-  const ConstraintKindInfo& kind(int, int) const override { return kTorqueLimit; }
+  explicit TorqueLimitTerm(const TermContext& c) : SampleTermOfOneKind(kTorqueLimit), c_(c) {}
   void appendRows(RowSink& sink) const override {
     const int n = c_.outputs.joints, s = sink.block();
     for (const int j : c_.torqueJoints)
@@ -117,12 +114,9 @@ class TorqueLimitTerm final : public ConstraintTerm {
 };
 
 /// detail k < closing: closing joint k's position; closing + k: its velocity.
-class ClosingJointLimitTerm final : public ConstraintTerm {
+class ClosingJointLimitTerm final : public SampleTermOfOneKind {
  public:
-  explicit ClosingJointLimitTerm(const TermContext& c) : c_(c) {}
-  RowPlace place() const override { return RowPlace::Sample; }
-  std::vector<ConstraintKindInfo> kinds() const override { return {kClosingJointLimit}; }
-  const ConstraintKindInfo& kind(int, int) const override { return kClosingJointLimit; }
+  explicit ClosingJointLimitTerm(const TermContext& c) : SampleTermOfOneKind(kClosingJointLimit), c_(c) {}
   void appendRows(RowSink& sink) const override {
     const int closing = c_.outputs.closing;
     for (int k = 0; k < closing; ++k) {

@@ -70,14 +70,14 @@ void MotionProblem::sampleLagrangianGradient(int s, const SampleBlock& b, const 
   for (const auto& term : costs_) term->addStateGradient(sample, objectiveWeight, gradient);
 }
 
-void MotionProblem::costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h,
-                                      bool curvatures) const {
+void MotionProblem::costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h) const {
   const CostSample sample = costSample(s, b);
   h.costSlopes.setZero();
-  for (const auto& term : costs_) term->addOutputSlopes(sample, objectiveWeight, h.costSlopes);
-  if (!curvatures) return;
   h.costCurvatures.setZero();
-  for (const auto& term : costs_) term->addOutputCurvatures(sample, objectiveWeight, h.costCurvatures);
+  for (const auto& term : costs_) {
+    term->addOutputSlopes(sample, objectiveWeight, h.costSlopes);
+    term->addOutputCurvatures(sample, objectiveWeight, h.costCurvatures);
+  }
 }
 
 void MotionProblem::outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights,
@@ -137,8 +137,7 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
   }
   // ... and the outputs' own: each output's weight at this point is its multiplier, plus on
   // Γ_j the power's slope times ∂P/∂Γ (P's own curvature is in the terms above).
-  costOutputWeights(s, b, objectiveWeight, h, false);
-  h.fixedWeights = multipliers;
+  h.fixedWeights = multipliers;  // h.costSlopes: the Gauss–Newton part above set them at this sample
   for (int j = 0; j < n; ++j) {
     const double slope = multipliers[outputs_.power(j)] + h.costSlopes[outputs_.power(j)];
     const MotorPowerDerivatives p =
@@ -196,7 +195,7 @@ void MotionProblem::sampleGaussNewtonHessian(int s, const SampleBlock& b, const 
   const int n = jointCount_, nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
   auto H = h.stateHessian.topLeftCorner(d, d);
   H.setZero();
-  costOutputWeights(s, b, objectiveWeight, h, true);
+  costOutputWeights(s, b, objectiveWeight, h);
   auto gradientOf = [&](int output, Eigen::Ref<Eigen::VectorXd> row) {
     row.segment(0, n) = b.dyDq.row(output).transpose();
     row.segment(n, n) = b.dyDv.row(output).transpose();
@@ -247,9 +246,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
   taskMultipliers_.setZero(taskRows_, static_cast<Eigen::Index>(taskBlocks_.size()));
   for (std::size_t r = 0; r < rows_.size(); ++r) {
     const Row& row = rows_[r];
-    const ConstraintTerm& term = *terms_[static_cast<std::size_t>(row.term)];
-    const double lambda = term.outputSign() * multipliers[static_cast<Eigen::Index>(r)];
-    switch (term.place()) {
+    const double lambda = row.sign * multipliers[static_cast<Eigen::Index>(r)];
+    switch (row.place) {
       case RowPlace::ControlPoints: break;  // linear in x at a fixed duration: the duration's part below
       case RowPlace::TaskInstant: taskMultipliers_(row.output, row.block) += lambda; break;
       case RowPlace::Sample: sampleMultipliers_(row.output, row.block) += lambda; break;
@@ -560,9 +558,9 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
     // limits, (x_second − x_first) / T) bring their own terms' curvature in T.
     const int column = parameterCount_;
     for (std::size_t r = 0; r < rows_.size(); ++r) {
-      const ConstraintTerm& term = *terms_[static_cast<std::size_t>(rows_[r].term)];
-      if (term.place() == RowPlace::ControlPoints)
-        term.addDirectHessian(rows_[r].detail, multipliers[static_cast<Eigen::Index>(r)], x, T, column, hessian);
+      if (rows_[r].place == RowPlace::ControlPoints)
+        terms_[static_cast<std::size_t>(rows_[r].term)]->addDirectHessian(rows_[r].detail, multipliers[static_cast<Eigen::Index>(r)],
+                                                                           x, T, column, hessian);
     }
   } else if (durationIsFree()) {
     // The duration's row and column: a forward difference of the whole gradient.

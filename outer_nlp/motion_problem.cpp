@@ -365,6 +365,7 @@ void MotionProblem::buildStructure() {
         : p_(problem), rows_(rows), columns_(columns), freeT_(problem.durationIsFree()) {}
     void start(int term, bool task, int block) {
       term_ = term, task_ = task, block_ = block;
+      place_ = p_.terms_[static_cast<std::size_t>(term)]->place();
       sign_ = p_.terms_[static_cast<std::size_t>(term)]->outputSign();
       b_ = block < 0 ? nullptr : task ? &p_.taskBlocks_[static_cast<std::size_t>(block)] : &p_.blocks_[static_cast<std::size_t>(block)];
     }
@@ -377,7 +378,7 @@ void MotionProblem::buildStructure() {
     }
     int slackColumn(int joint) const override { return p_.slackIndex(block_, joint); }
     void outputRow(int detail, int output, const std::vector<int>& dependsOn, bool withForces, int slack) override {
-      p_.rows_.push_back({term_, detail, block_, output, slack});
+      p_.rows_.push_back({term_, detail, block_, output, slack, place_, sign_});
       const SampleBlock& b = *b_;
       const int k = static_cast<int>(b.parameters.size()) / p_.jointCount_;
       for (const int j : dependsOn)
@@ -389,13 +390,13 @@ void MotionProblem::buildStructure() {
       if (slack >= 0) entry(slack, {Source::Slack, false, block_, -1, -1, 1.0});
     }
     void contactRow(int detail, int output, int contact) override {
-      p_.rows_.push_back({term_, detail, block_, output, -1});
+      p_.rows_.push_back({term_, detail, block_, output, -1, place_, sign_});
       for (const SampleBlock::ForceTerm& t : b_->forceTerms)
         for (int l = t.firstColumn; t.contact == contact && l < t.firstColumn + 6; ++l)
           entry(b_->forceColumns[static_cast<std::size_t>(l)], {Source::Force, task_, block_, output, l, sign_});
     }
     void directRow(int detail, int first, int second) override {
-      p_.rows_.push_back({term_, detail, -1, -1, -1});
+      p_.rows_.push_back({term_, detail, -1, -1, -1, RowPlace::ControlPoints, 1.0});
       entry(first, {Source::Direct, false, -1, -1, 0, 1.0});
       entry(second, {Source::Direct, false, -1, -1, 1, 1.0});
       if (freeT_) entry(p_.parameterCount_, {Source::Direct, false, -1, -1, 2, 1.0});
@@ -411,6 +412,7 @@ void MotionProblem::buildStructure() {
     const bool freeT_;
     int term_ = 0, block_ = -1;
     bool task_ = false;
+    RowPlace place_ = RowPlace::Sample;
     double sign_ = 1.0;
     const SampleBlock* b_ = nullptr;
   };
@@ -450,7 +452,7 @@ std::string MotionProblem::rowName(int row) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
   std::ostringstream name;
   name << rowSubject(row);
-  switch (terms_[static_cast<std::size_t>(r.term)]->place()) {
+  switch (r.place) {
     case RowPlace::ControlPoints: name << " (control points)"; break;
     case RowPlace::TaskInstant: name << " at u = " << taskSamples_.time(r.block, 1.0) << " of the motion"; break;
     case RowPlace::Sample: name << " at sample " << r.block; break;
@@ -460,7 +462,7 @@ std::string MotionProblem::rowName(int row) const {
 
 double MotionProblem::rowTime(int row, double T) const {
   const Row& r = rows_[static_cast<std::size_t>(row)];
-  switch (terms_[static_cast<std::size_t>(r.term)]->place()) {
+  switch (r.place) {
     case RowPlace::ControlPoints: return std::numeric_limits<double>::quiet_NaN();
     case RowPlace::TaskInstant: return taskSamples_.time(r.block, T);
     case RowPlace::Sample: break;
@@ -1046,13 +1048,12 @@ void MotionProblem::objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd&
 }
 
 double MotionProblem::rowValue(const Row& row, const Eigen::VectorXd& x, double T) const {
-  const ConstraintTerm& term = *terms_[static_cast<std::size_t>(row.term)];
-  switch (term.place()) {
-    case RowPlace::ControlPoints: return term.directValue(row.detail, x, T);
+  switch (row.place) {
+    case RowPlace::ControlPoints: return terms_[static_cast<std::size_t>(row.term)]->directValue(row.detail, x, T);
     case RowPlace::TaskInstant: return taskBlocks_[static_cast<std::size_t>(row.block)].y[row.output];
     case RowPlace::Sample: break;
   }
-  const double y = term.outputSign() * blocks_[static_cast<std::size_t>(row.block)].y[row.output];
+  const double y = row.sign * blocks_[static_cast<std::size_t>(row.block)].y[row.output];
   return row.slack >= 0 ? x[row.slack] + y : y;
 }
 

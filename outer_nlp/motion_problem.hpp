@@ -312,9 +312,12 @@ class MotionProblem final : public NlpProblem {
   }
   /// A row of the registry: the term that laid it out (terms_), what `detail` says to that
   /// term (joint, contact row, task component…), the sample or task instant it belongs to (−1:
-  /// the control points), the output it reads and its own slack variable (−1: none).
+  /// the control points), the output it reads and its own slack variable (−1: none); the
+  /// term's place and sign, kept here so that evaluations ask the term nothing per row.
   struct Row {
     int term, detail, block, output, slack;
+    RowPlace place;
+    double sign;
   };
   /// Where a Jacobian entry's value comes from (Direct: the term's directDerivative along local column `local`).
   struct JacobianEntry {
@@ -410,9 +413,9 @@ class MotionProblem final : public NlpProblem {
   CostSample costSample(int s, const SampleBlock& b) const {
     return CostSample{s, b.y, b.acceleration, b.closed, b.dyDx, b.dyDT, b.dyDz, b.parameters, b.forceColumns};
   }
-  /// The cost terms' slopes (and with `curvatures` their curvatures) in sample s's outputs at
-  /// b, times objectiveWeight, into h.costSlopes (h.costCurvatures).
-  void costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h, bool curvatures) const;
+  /// The cost terms' slopes and curvatures in sample s's outputs at b, times objectiveWeight,
+  /// into h.costSlopes and h.costCurvatures.
+  void costOutputWeights(int s, const SampleBlock& b, double objectiveWeight, HessianWorkspace& h) const;
   /// Σ_o weights_o ∇y_o in the state (q, q̇, q̈) and force columns of `b`, weights held fixed.
   void outputGradient(const SampleBlock& b, const Eigen::VectorXd& weights, Eigen::Ref<Eigen::VectorXd> gradient) const;
   /// ∂W_ref/∂(state, force columns) at the point sampleOutputs last evaluated in `w`, 6 × d.
