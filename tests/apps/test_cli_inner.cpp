@@ -81,7 +81,10 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
       }
       // The objective reported is the objective of the wrenches reported, without regularisation.
       CHECK(result["objective"].get<double>() == Approx(p.objective(F)).epsilon(1e-12));
-      CHECK(std::abs(result["objective"].get<double>() - expected.objective) <= 1e-6 * (1 + std::abs(expected.objective)));
+      // The command warm-starts each problem from the previous answer, the library call here is
+      // cold: certified answers agree; a failed one is nobody's optimum and may stop elsewhere.
+      if (expected.status != InnerStatus::Failed)
+        CHECK(std::abs(result["objective"].get<double>() - expected.objective) <= 1e-6 * (1 + std::abs(expected.objective)));
       if (std::string(solver) == "active-set") CHECK(result["status"] == (k < 3 ? "optimal" : "infeasible"));
       for (const char* key : {"multipliers", "active_set", "iterations", "kkt_residual", "solve_time_us", "balance_slack"})
         CHECK(result.contains(key));
