@@ -23,12 +23,17 @@ const char* toString(InnerStatus status) {
   return "failed";
 }
 
+// Factories of solvers known only by name (each in its own file).
+std::unique_ptr<InnerSolver> makeAugLagMmaSolver(const InnerSettings& settings);
+
 const std::vector<InnerSolverEntry>& innerSolvers() {
   static const std::vector<InnerSolverEntry> registry = {
       {"active-set", "ours: a dual active-set QP in an SQP loop over the cones, warm-started along the motion",
        makeActiveSetSolver},
       {"slsqp", "NLopt's SLSQP (sequential quadratic programming; the report's FSQP analogue)", makeSlsqpSolver},
       {"ipopt", "Ipopt's interior point, one NLP a solve (the report's baseline)", makeIpoptSolver},
+      {"auglag-mma", "NLopt's augmented Lagrangian over every constraint, MMA (moving asymptotes) on its subproblems",
+       makeAugLagMmaSolver},
   };
   return registry;
 }
