@@ -25,6 +25,7 @@ const char* toString(InnerStatus status) {
 
 // Factories of solvers known only by name (each in its own file).
 std::unique_ptr<InnerSolver> makeAugLagMmaSolver(const InnerSettings& settings);
+std::unique_ptr<InnerSolver> makeAugLagLbfgsSolver(const InnerSettings& settings);
 
 const std::vector<InnerSolverEntry>& innerSolvers() {
   static const std::vector<InnerSolverEntry> registry = {
@@ -34,6 +35,8 @@ const std::vector<InnerSolverEntry>& innerSolvers() {
       {"ipopt", "Ipopt's interior point, one NLP a solve (the report's baseline)", makeIpoptSolver},
       {"auglag-mma", "NLopt's augmented Lagrangian over every constraint, MMA (moving asymptotes) on its subproblems",
        makeAugLagMmaSolver},
+      {"auglag-lbfgs", "NLopt's augmented Lagrangian over every constraint, L-BFGS on its subproblems",
+       makeAugLagLbfgsSolver},
   };
   return registry;
 }

@@ -194,7 +194,7 @@ def test_bad_types_and_names_raise(hrp2):
         mcopt.InnerProblem(**data, contact_model="cone")
     with pytest.raises(mcopt.InputError, match="only the pyramid contact model has facets"):
         mcopt.InnerProblem(**data, pyramid_facets=6)
-    with pytest.raises(mcopt.InputError, match="expected active-set, slsqp, ipopt or auglag-mma; got 'simplex'"):
+    with pytest.raises(mcopt.InputError, match="expected active-set, slsqp, ipopt, auglag-mma or auglag-lbfgs; got 'simplex'"):
         mcopt.InnerSolver("simplex")
     d = mcopt.Dynamics(hrp2, "r_sole")
     with pytest.raises(ValueError, match="unknown contact surface 'foot'"):
