@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: BSD-3-Clause
-"""Compare the three inner contact-force solvers over a motion (docs/reference/python.md).
+"""Compare three inner contact-force solvers over a motion — ours and the report's two (docs/reference/python.md).
 
 The motion is a bundled two-contact scenario (by default the weight shift: both soles on the
 floor) after a few Ipopt iterations (`mcopt run --max-iterations K`), its centre of mass on

@@ -11,7 +11,7 @@ A solver *reaches the conic optimum* on a problem when its wrenches are feasible
 its objective, with the Tikhonov term, is at most 1e-6 (1 + |f*|) above the conic one's.
 
     scripts/inner_baselines.py [--count N] [--seed S] [--mcopt PATH] [--out REPORT.json]
-                               [--keep DIR] [--solvers active-set,slsqp,ipopt]
+                               [--keep DIR] [--solvers active-set,slsqp,ipopt,auglag-mma,auglag-lbfgs]
 
 Prints a Markdown table and every miss (problem, solver, status, objective gap, violation,
 message); REPORT.json holds the same. Problems whose conic optimum CVXOPT cannot certify are
@@ -198,7 +198,7 @@ def main():
     parser.add_argument("--count", type=int, default=1000)
     parser.add_argument("--seed", type=int, default=19)
     parser.add_argument("--mcopt", default=os.environ.get("MCOPT_EXECUTABLE", "build/release/apps/mcopt"))
-    parser.add_argument("--solvers", default="active-set,slsqp,ipopt")
+    parser.add_argument("--solvers", default="active-set,slsqp,ipopt,auglag-mma,auglag-lbfgs")
     parser.add_argument("--out", help="report JSON (written atomically)")
     parser.add_argument("--keep", help="folder for the problems and mcopt's outputs (default: a temporary one)")
     args = parser.parse_args()

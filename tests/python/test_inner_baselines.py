@@ -31,6 +31,11 @@ def test_reduced_comparison(tmp_path):
     assert table["active-set"]["reached"] == 90
     assert table["slsqp"]["reached"] >= 89
     assert table["ipopt"]["reached"] >= 89
+    # NLopt's augmented Lagrangian: measured 87 (L-BFGS) and 56 (MMA) of these 90; one miss of margin.
+    assert table["auglag-lbfgs"]["reached"] >= 86
+    assert table["auglag-mma"]["reached"] >= 55
+    for solver in table:  # a certified `optimal` is always at the conic optimum
+        assert table[solver]["optimal_status"] <= table[solver]["reached"], solver
     assert data["unloaded_at_optimum"] >= 3  # the apex family is represented
     assert "| active-set | 90 (100.0 %)" in run.stdout
 
