@@ -28,7 +28,7 @@ install(TARGETS mcopt RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runt
 set(mcopt_private_headers
   core/hot_path_checks.hpp core/no_malloc_scope.hpp core/yaml_fields.hpp core/text_encoding.hpp core/path_status.hpp
   core/atomic_file.hpp
-  inner_qp/answer_polishing.hpp inner_qp/inner_nlp.hpp inner_qp/dual_active_set_qp.hpp
+  inner_qp/answer_polishing.hpp inner_qp/inner_nlp.hpp inner_qp/nlopt_problem.hpp inner_qp/dual_active_set_qp.hpp
   sensitivity/sparse_kkt_factor.hpp
   outer_nlp/motion_workspace.hpp outer_nlp/scenario_yaml.hpp outer_nlp/smooth_maximum.hpp
   study/child_process.hpp study/scenario_tree.hpp)

@@ -9,16 +9,7 @@
 namespace mcopt {
 
 std::unique_ptr<InnerSolver> makeAugLagLbfgsSolver(const InnerSettings& settings) {
-  inner_detail::NloptMethod method;
-  method.algorithm = NLOPT_AUGLAG;
-  method.local = NLOPT_LD_LBFGS;
-  method.scaled = true;
-  method.xtolRel = 1e-12;
-  method.ftolRel = 1e-15;
-  method.localXtolRel = 1e-12;
-  method.localFtolRel = 1e-14;
-  method.evaluationsPerIteration = 20;
-  return inner_detail::makeNloptSolver("auglag-lbfgs", method, settings);
+  return inner_detail::makeNloptSolver("auglag-lbfgs", inner_detail::augmentedLagrangian(NLOPT_LD_LBFGS), settings);
 }
 
 }  // namespace mcopt

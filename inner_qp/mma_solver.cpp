@@ -11,16 +11,7 @@
 namespace mcopt {
 
 std::unique_ptr<InnerSolver> makeAugLagMmaSolver(const InnerSettings& settings) {
-  inner_detail::NloptMethod method;
-  method.algorithm = NLOPT_AUGLAG;
-  method.local = NLOPT_LD_MMA;
-  method.scaled = true;
-  method.xtolRel = 1e-12;
-  method.ftolRel = 1e-15;
-  method.localXtolRel = 1e-12;
-  method.localFtolRel = 1e-14;
-  method.evaluationsPerIteration = 20;
-  return inner_detail::makeNloptSolver("auglag-mma", method, settings);
+  return inner_detail::makeNloptSolver("auglag-mma", inner_detail::augmentedLagrangian(NLOPT_LD_MMA), settings);
 }
 
 }  // namespace mcopt

@@ -5,9 +5,54 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 #include <utility>
+#include <vector>
 
 namespace mcopt::inner_detail {
+
+/// How NLopt sees the inner problem: x = wrenchUnit · y for its variables y, the objective
+/// divided by objectiveUnit and the constraints (all homogeneous of degree one in the wrenches
+/// but for their bounds) by wrenchUnit. 1 and 1: the problem as it is.
+struct NloptScaling {
+  double wrenchUnit = 1.0;
+  double objectiveUnit = 1.0;
+};
+
+/// An InnerNlp set on an NLopt optimiser: objective, the balance equalities and the
+/// inequalities, with tolerances relative to the data's scale; counts the objective's
+/// evaluations. `nlp` must outlive the optimisation.
+class NloptProblem {
+ public:
+  NloptProblem(nlopt_opt opt, const InnerNlp& nlp, const InnerSettings& settings, NloptScaling scaling = {});
+  NloptProblem(const NloptProblem&) = delete;
+  NloptProblem& operator=(const NloptProblem&) = delete;
+
+  int evaluations() const { return evaluations_; }
+  /// Largest violation of the balance and the inequalities at x (absolute).
+  double violation(const Eigen::VectorXd& x) const;
+
+ private:
+  static double objective(unsigned, const double* x, double* gradient, void* data);
+  static void equalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data);
+  static void inequalities(unsigned, double* value, unsigned, const double* x, double* jacobian, void* data);
+  /// The wrenches at NLopt's point y (y itself when unscaled).
+  const double* wrenches(const double* y);
+
+  const InnerNlp& nlp_;
+  NloptScaling scaling_;
+  bool scaled_ = false;
+  Eigen::VectorXd x_;  ///< the wrenches of the scaled point (sized once)
+  std::vector<double> equalityTolerance_, inequalityTolerance_;
+  int evaluations_ = 0;
+};
+
+/// Whether an NLopt return code is a stop at a point the common flow may check: a positive
+/// code other than a budget, or NLOPT_ROUNDOFF_LIMITED (usable more often than not).
+bool nloptStopped(int code);
+/// "nlopt: <name of the code>".
+std::string nloptMessage(int code);
+
 
 NloptProblem::NloptProblem(nlopt_opt opt, const InnerNlp& nlp, const InnerSettings& settings, NloptScaling scaling)
     : nlp_(nlp), scaling_(scaling), scaled_(scaling.wrenchUnit != 1.0 || scaling.objectiveUnit != 1.0) {
@@ -72,6 +117,19 @@ bool nloptStopped(int code) {
 
 std::string nloptMessage(int code) {
   return std::string("nlopt: ") + nlopt_result_to_string(static_cast<nlopt_result>(code));
+}
+
+NloptMethod augmentedLagrangian(int local) {
+  NloptMethod method;
+  method.algorithm = NLOPT_AUGLAG;
+  method.local = local;
+  method.scaled = true;
+  method.xtolRel = 1e-12;
+  method.ftolRel = 1e-15;
+  method.localXtolRel = 1e-12;
+  method.localFtolRel = 1e-14;
+  method.evaluationsPerIteration = 20;
+  return method;
 }
 
 RunOutcome runNlopt(const NloptMethod& method, const ContactProblem& problem, BalanceMode balance, double band,
