@@ -110,6 +110,24 @@ inline double number(const std::filesystem::path& file, const YAML::Node& node, 
   return value;
 }
 
+/// An integer from `minimum` to 1e7 (YAML's 3 or 3.0).
+inline int integerAtLeast(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, int minimum) {
+  const double value = number(file, node, field);
+  if (value != std::floor(value) || value < minimum || value > 1e7)
+    throw InputError(where(file, node, field) + "expected an integer ≥ " + std::to_string(minimum));
+  return static_cast<int>(value);
+}
+
+/// true or false.
+inline bool flag(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  try {
+    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
+    return node.as<bool>();
+  } catch (const YAML::Exception&) {
+    throw InputError(where(file, node, field) + "expected true or false");
+  }
+}
+
 inline double positive(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
   const double value = number(file, node, field);
   if (value <= 0.0) throw InputError(where(file, node, field) + "must be positive, got " + std::to_string(value));

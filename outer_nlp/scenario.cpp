@@ -20,22 +20,6 @@ namespace {
 using yaml::where;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-int integerField(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, int minimum) {
-  const double value = yaml::number(file, node, field);
-  if (value != std::floor(value) || value < minimum || value > 1e7)
-    throw InputError(where(file, node, field) + "expected an integer ≥ " + std::to_string(minimum));
-  return static_cast<int>(value);
-}
-
-bool flag(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
-  try {
-    if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
-    return node.as<bool>();
-  } catch (const YAML::Exception&) {
-    throw InputError(where(file, node, field) + "expected true or false");
-  }
-}
-
 std::filesystem::path sideFile(const std::filesystem::path& file, const YAML::Node& root, const char* key) {
   const YAML::Node node = yaml::required(file, root, key, "");
   // Paths are relative to the scenario file, never to the working directory.
@@ -156,214 +140,6 @@ TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, con
   return t;
 }
 
-void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
-  if (!node.IsMap()) throw InputError(where(file, node, "solver") + "expected a mapping of Ipopt options");
-  for (const auto& entry : node) {
-    const std::string name = entry.first.as<std::string>();
-    const std::string field = "solver." + name;
-    if (!entry.second.IsScalar()) throw InputError(where(file, entry.second, field) + "expected a scalar value");
-    SolverOption o;
-    o.name = name;
-    o.origin = where(file, entry.first, field);
-    o.text = entry.second.as<std::string>();
-    // YAML decides the type: 3000 is an integer, 1e-8 or 0.5 a number, anything else text.
-    char* endPointer = nullptr;
-    const long asLong = std::strtol(o.text.c_str(), &endPointer, 10);
-    if (!o.text.empty() && *endPointer == '\0') {
-      o.type = SolverOption::Type::Integer;
-      o.integer = static_cast<int>(asLong);
-    } else {
-      const double asDouble = std::strtod(o.text.c_str(), &endPointer);
-      if (!o.text.empty() && *endPointer == '\0') {
-        o.type = SolverOption::Type::Number;
-        o.number = asDouble;
-      }
-    }
-    s.solverOptions.push_back(o);
-  }
-}
-
-
-/// The world pose of a contact frame in a posture (the reference body at its scenario pose).
-RigidTransform contactPoseAt(const Scenario& s, const ContactSurface& surface, const Eigen::VectorXd& posture) {
-  const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
-  DynamicsData data(model);
-  forwardKinematics(model, data, posture);
-  return framePose(model, data, surface.frame) * surface.placement;
-}
-
-/// The closure of a contact as two tasks over its window (formulation.md §10): the contact
-/// frame's origin at its world position, the body's orientation at the one that puts the
-/// contact frame at its world orientation. The motion problem holds them by construction
-/// (closed_chains.hpp); the configuration problem keeps them within the band. At each end of a
-/// window inside the motion, where the splines meet the closure, four tasks of equality: the
-/// frame at its pose and at rest (the motion C¹ there: its accelerations jump with the wrench).
-void addClosureTasks(const EnvironmentContact& c, Scenario& s) {
-  const int frame = c.surface.frame;
-  TaskSpec position;
-  position.name = "closure of " + c.surface.name + " (position)";
-  position.origin = c.origin;
-  position.closure = true;
-  position.heldByConstruction = true;
-  position.task = makePositionTask(frame, c.surface.placement.translation);
-  position.start = c.start, position.end = c.end, position.window = c.end > c.start;
-  position.lower = c.worldPose.translation.array() - s.closurePositionTolerance;
-  position.upper = c.worldPose.translation.array() + s.closurePositionTolerance;
-  TaskSpec orientation = position;
-  orientation.name = "closure of " + c.surface.name + " (orientation)";
-  orientation.task = makeOrientationTask(frame, c.worldPose.rotation * c.surface.placement.rotation.transpose());
-  orientation.lower.setConstant(3, -s.closureOrientationTolerance);
-  orientation.upper.setConstant(3, s.closureOrientationTolerance);
-  s.tasks.push_back(position);
-  s.tasks.push_back(orientation);
-  if (!c.window) return;
-  for (const double end : {c.start, c.end}) {
-    if (end <= 0.0 || end >= s.duration.initial) continue;
-    const std::string at = std::string(" at its window's ") + (end == c.start ? "start" : "end");
-    TaskSpec meet = position;
-    meet.heldByConstruction = false;
-    meet.start = meet.end = end, meet.window = false;
-    TaskSpec p = meet, o = orientation, v = meet, w = meet;
-    p.name = "closure of " + c.surface.name + at + " (position)";
-    p.lower = p.upper = c.worldPose.translation;
-    o.heldByConstruction = false;
-    o.start = o.end = end, o.window = false;
-    o.name = "closure of " + c.surface.name + at + " (orientation)";
-    o.lower.setZero(3), o.upper.setZero(3);
-    v.name = "closure of " + c.surface.name + at + " (velocity)";
-    v.task = makeLinearVelocityTask(frame, c.surface.placement.translation);
-    v.lower.setZero(3), v.upper.setZero(3);
-    w.name = "closure of " + c.surface.name + at + " (angular velocity)";
-    w.task = makeAngularVelocityTask(frame);
-    w.lower.setZero(3), w.upper.setZero(3);
-    for (const TaskSpec* t : {&p, &o, &v, &w}) s.tasks.push_back(*t);
-  }
-}
-
-void readContacts(const std::filesystem::path& file, const YAML::Node& list, const std::vector<ContactSurface>& surfaces,
-                  Scenario& s) {
-  const int referenceBody = s.robot.frames[static_cast<std::size_t>(s.robot.frameIndex(s.referenceBody))].body;
-  bool haveReference = false;
-  std::vector<std::string> seen;
-  for (std::size_t i = 0; i < list.size(); ++i) {
-    const YAML::Node entry = list[i];
-    const std::string field = "contacts[" + std::to_string(i) + "]";
-    // (A YAML::Node handle is never re-assigned: assignment writes through to the node it refers to.)
-    if (entry.IsMap()) yaml::rejectUnknownKeys(file, entry, field, {"surface", "window", "pose", "model"});
-    const YAML::Node nameNode = entry.IsMap() ? yaml::required(file, entry, "surface", field) : entry;
-    const std::string name = yaml::text(file, nameNode, entry.IsMap() ? field + ".surface" : field);
-    const auto surface = std::find_if(surfaces.begin(), surfaces.end(), [&](const ContactSurface& c) { return c.name == name; });
-    if (surface == surfaces.end())
-      throw InputError(where(file, nameNode, field) + "unknown contact surface '" + name + "'");
-    if (std::find(seen.begin(), seen.end(), name) != seen.end())
-      throw InputError(where(file, nameNode, field) + "contact '" + name + "' is listed twice");
-    seen.push_back(name);
-    const bool onReference = s.robot.frames[static_cast<std::size_t>(surface->frame)].body == referenceBody;
-    if (onReference) {
-      if (haveReference)
-        throw InputError(where(file, nameNode, field) + "a second contact on the reference body '" + s.referenceBody + "'");
-      if (entry.IsMap() && (entry["window"] || entry["pose"]))
-        throw InputError(where(file, entry["window"] ? entry["window"] : entry["pose"], field) + "contact '" + name +
-                         "' is on the reference body, which is fixed in the world for the whole motion: it takes no "
-                         "window and no pose (reference_pose places it)");
-      if (entry.IsMap() && entry["model"])
-        throw InputError(where(file, entry["model"], field + ".model") + "contact '" + name +
-                         "' is on the reference body, whose contact model is the scenario's (inner.contact_model)");
-      s.support = *surface;
-      haveReference = true;
-      continue;
-    }
-    EnvironmentContact c;
-    c.surface = *surface;
-    c.origin = where(file, entry, field);
-    c.origin.resize(c.origin.size() - 2);
-    if (entry.IsMap() && entry["model"]) {
-      const YAML::Node model = entry["model"];
-      const std::string modelName = yaml::text(file, model, field + ".model");
-      if (!isContactModelName(modelName))
-        throw InputError(where(file, model, field + ".model") + "unknown contact model '" + modelName + "' (expected " +
-                         contactModelList() + ")");
-      if (modelName == "pyramid")
-        throw InputError(where(file, model, field + ".model") +
-                         "a contact's own model takes no parameters: the pyramid is inner.contact_model's, with "
-                         "inner.pyramid_facets");
-      s.inner.problem.byContact[name] = makeContactModel(modelName);
-    }
-    c.end = s.duration.initial;
-    if (entry.IsMap() && entry["window"]) {
-      const YAML::Node w = entry["window"];
-      const auto t = yaml::numbers(file, w, field + ".window", 2);
-      const double T = s.duration.initial;
-      if (!(t[0] >= 0.0 && t[0] < t[1] && t[1] <= T * (1 + 1e-12)))
-        throw InputError(where(file, w, field + ".window") + "expected [start, end] with 0 ≤ start < end ≤ " +
-                         std::to_string(T) + " s (the motion)");
-      int inside = 0;
-      for (int k = 0; k < s.samples; ++k) {
-        const double tk = T * k / (s.samples - 1);
-        inside += tk >= t[0] - 1e-9 * T && tk <= t[1] + 1e-9 * T;
-      }
-      if (inside == 0)
-        throw InputError(where(file, w, field + ".window") + "holds no sample of the motion (" + std::to_string(s.samples) +
-                         " samples over " + std::to_string(T) + " s)");
-      c.start = t[0], c.end = t[1], c.window = true;
-    }
-    if (entry.IsMap() && entry["pose"]) {
-      const YAML::Node pose = entry["pose"];
-      yaml::rejectUnknownKeys(file, pose, field + ".pose", {"position", "rpy"});
-      const auto p = yaml::numbers(file, yaml::required(file, pose, "position", field + ".pose"), field + ".pose.position", 3);
-      const auto r = yaml::numbers(file, yaml::required(file, pose, "rpy", field + ".pose"), field + ".pose.rpy", 3);
-      c.worldPose.translation = Vector3(p[0], p[1], p[2]);
-      c.worldPose.rotation = rotationFromRpy(r[0], r[1], r[2]);
-      c.poseGiven = true;
-    } else {
-      c.worldPose = contactPoseAt(s, c.surface, s.start);
-    }
-    s.contacts.push_back(c);
-  }
-  if (!haveReference)
-    throw InputError(where(file, list, "contacts") + "no contact on the reference body '" + s.referenceBody +
-                     "' (the reference body's surface must be one of the contacts)");
-  for (const EnvironmentContact& c : s.contacts) addClosureTasks(c, s);
-}
-
-void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
-  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish"});
-  if (node["solver"]) {
-    const std::string name = yaml::text(file, node["solver"], "inner.solver");
-    if (!isInnerSolverName(name))
-      throw InputError(where(file, node["solver"], "inner.solver") + "unknown inner solver '" + name +
-                       "' (expected " + innerSolverList() + ")");
-    s.inner.solverName = name;
-  }
-  std::string modelName = s.inner.problem.model->name();
-  if (node["contact_model"]) {
-    modelName = yaml::text(file, node["contact_model"], "inner.contact_model");
-    if (!isContactModelName(modelName))
-      throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" +
-                       modelName + "' (expected " + contactModelList() + ")");
-  }
-  ContactModelOptions options;
-  if (node["pyramid_facets"]) {
-    if (modelName != "pyramid")
-      throw InputError(where(file, node["pyramid_facets"], "inner.pyramid_facets") +
-                       "only the pyramid contact model has facets (the contact model is " + modelName + ")");
-    options.pyramidFacets = integerField(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
-  }
-  s.inner.problem.model = makeContactModel(modelName, options);
-  if (s.inner.problem.model->wrenchSize() < 6)
-    throw InputError(where(file, node["contact_model"], "inner.contact_model") + "the " + modelName +
-                     " model holds a force alone, no moment: give it to a contact (contacts[k].model: " + modelName +
-                     "), not to every contact — the reference contact carries moments");
-  if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
-  if (node["polish"]) s.inner.solver.polish = flag(file, node["polish"], "inner.polish");
-  if (node["kkt_backend"]) {
-    try {
-      s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));
-    } catch (const InputError& e) {
-      throw InputError(where(file, node["kkt_backend"], "inner.kkt_backend") + e.what());
-    }
-  }
-}
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                       std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia);
 
@@ -400,56 +176,6 @@ ContactForces parseContactForces(const std::string& name) {
                    ")");
 }
 
-namespace {
-struct HessianName {
-  HessianOption option;
-  const char* name;
-};
-constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited-memory"},
-                                         {HessianOption::FiniteDifferences, "finite-differences"},
-                                         {HessianOption::SampleDifferences, "sample-differences"},
-                                         {HessianOption::ConvexSampleDifferences, "convex-sample-differences"},
-                                         {HessianOption::GaussNewton, "gauss-newton"},
-                                         {HessianOption::Exact, "exact"}};
-}  // namespace
-
-const char* toString(HessianOption hessian) {
-  for (const HessianName& h : kHessianNames)
-    if (h.option == hessian) return h.name;
-  return "?";
-}
-
-HessianOption parseHessianOption(const std::string& name) {
-  for (const HessianName& h : kHessianNames)
-    if (name == h.name) return h.option;
-  throw InputError("expected " + alternatives(hessianOptionNames()) + ", got '" + name + "'");
-}
-
-const std::vector<std::string>& hessianOptionNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> all;
-    for (const HessianName& h : kHessianNames) all.emplace_back(h.name);
-    return all;
-  }();
-  return names;
-}
-
-std::string exactHessianRefusal(const Scenario& s) {
-  if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
-    return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
-           "variables, or hessian: sample-differences";
-  if (!s.contacts.empty())
-    return "contact '" + s.contacts.front().surface.name + "' is held by construction, its loop's closing joints following the others "
-           "(docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no rule for that map; use "
-           "hessian: sample-differences or gauss-newton";
-  for (const Joint& joint : s.robot.joints)
-    if (joint.type == JointType::Prismatic)
-      return "prismatic joint '" + joint.name + "': its stencil assumes revolute joints";
-  if (s.energyForm == EnergyForm::Epigraph && s.duration.free())
-    return "the epigraph form with a free duration (its slack × duration term lies outside the Hessian's variables)";
-  return {};
-}
-
 Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces,
                       bool allowNonPhysicalInertia) {
   return loadScenario(yaml::loadFile(file), file, contactForces, allowNonPhysicalInertia);
@@ -477,7 +203,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   // Inertias a real body cannot have (robot_model.hpp UrdfOptions): refused unless the file or the
   // command line allows them, then loaded with a warning each.
   s.allowNonPhysicalInertia = allowNonPhysicalInertia ||
-      (root["allow_nonphysical_inertia"] && flag(file, root["allow_nonphysical_inertia"], "allow_nonphysical_inertia"));
+      (root["allow_nonphysical_inertia"] && yaml::flag(file, root["allow_nonphysical_inertia"], "allow_nonphysical_inertia"));
   s.robot = loadUrdfFile(sideFile(file, root, "robot"), {s.allowNonPhysicalInertia});
   s.actuators = loadActuators(sideFile(file, root, "actuators"), s.robot);
   s.contactSurfacesFile = sideFile(file, root, "contact_surfaces");
@@ -535,9 +261,9 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   } else {
     s.duration.initial = s.duration.lower = s.duration.upper = yaml::positive(file, durationNode, "duration");
   }
-  if (root["samples"]) s.samples = integerField(file, root["samples"], "samples", 2);
-  if (root["control_points"]) s.controlPoints = integerField(file, root["control_points"], "control_points", 7);
-  if (root["output_samples"]) s.outputSamples = integerField(file, root["output_samples"], "output_samples", 2);
+  if (root["samples"]) s.samples = yaml::integerAtLeast(file, root["samples"], "samples", 2);
+  if (root["control_points"]) s.controlPoints = yaml::integerAtLeast(file, root["control_points"], "control_points", 7);
+  if (root["output_samples"]) s.outputSamples = yaml::integerAtLeast(file, root["output_samples"], "output_samples", 2);
 
   if (root["objective"]) {
     const YAML::Node o = root["objective"];
@@ -560,16 +286,16 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     const YAML::Node l = root["limits"];
     yaml::rejectUnknownKeys(file, l, "limits",
                             {"position", "velocity", "torque", "torque_screening", "contact", "minimum_normal_force"});
-    if (l["position"]) s.positionLimits = flag(file, l["position"], "limits.position");
-    if (l["velocity"]) s.velocityLimits = flag(file, l["velocity"], "limits.velocity");
-    if (l["torque"]) s.torqueLimits = flag(file, l["torque"], "limits.torque");
+    if (l["position"]) s.positionLimits = yaml::flag(file, l["position"], "limits.position");
+    if (l["velocity"]) s.velocityLimits = yaml::flag(file, l["velocity"], "limits.velocity");
+    if (l["torque"]) s.torqueLimits = yaml::flag(file, l["torque"], "limits.torque");
     if (l["torque_screening"]) {
       s.torqueScreening = yaml::nonNegative(file, l["torque_screening"], "limits.torque_screening");
       if (s.torqueScreening >= 1.0)
         throw InputError(where(file, l["torque_screening"], "limits.torque_screening") +
                          "expected a fraction of the limit in [0, 1) (0: every row in the problem)");
     }
-    if (l["contact"]) s.contactConstraints = flag(file, l["contact"], "limits.contact");
+    if (l["contact"]) s.contactConstraints = yaml::flag(file, l["contact"], "limits.contact");
     if (l["minimum_normal_force"])
       s.minimumNormalForce = yaml::nonNegative(file, l["minimum_normal_force"], "limits.minimum_normal_force");
   }
@@ -592,7 +318,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   const YAML::Node startNode = yaml::required(file, root, "start", "");
   const YAML::Node endNode = yaml::required(file, root, "end", "");
   s.start = readPosture(file, startNode, "start", s.robot, postures);
-  if (startNode["fixed"]) s.fixStart = flag(file, startNode["fixed"], "start.fixed");
+  if (startNode["fixed"]) s.fixStart = yaml::flag(file, startNode["fixed"], "start.fixed");
   if (endNode.IsMap() && endNode["same_as"]) {
     // The periodic boundary: the end is the start's posture variables themselves.
     yaml::rejectUnknownKeys(file, endNode, "end", {"same_as"});
@@ -604,7 +330,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     s.fixEnd = s.fixStart;
   } else {
     s.end = readPosture(file, endNode, "end", s.robot, postures);
-    if (endNode["fixed"]) s.fixEnd = flag(file, endNode["fixed"], "end.fixed");
+    if (endNode["fixed"]) s.fixEnd = yaml::flag(file, endNode["fixed"], "end.fixed");
   }
   if (s.positionLimits)
     for (int j = 0; j < s.robot.jointCount(); ++j) {
@@ -633,18 +359,18 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   }
   if (contactForces) s.contactForces = *contactForces;
   if (root["force_control_points"])
-    s.forceControlPoints = integerField(file, root["force_control_points"], "force_control_points", 4);
+    s.forceControlPoints = yaml::integerAtLeast(file, root["force_control_points"], "force_control_points", 4);
   if (root["inner"]) readInnerSettings(file, root["inner"], s);
   if (root["initialisation"]) {
     const YAML::Node init = root["initialisation"];
     yaml::rejectUnknownKeys(file, init, "initialisation", {"configuration_optimisation", "configuration_iterations"});
     if (init["configuration_optimisation"])
-      s.configurationOptimisation = flag(file, init["configuration_optimisation"], "initialisation.configuration_optimisation");
+      s.configurationOptimisation = yaml::flag(file, init["configuration_optimisation"], "initialisation.configuration_optimisation");
     if (init["configuration_iterations"])
       s.configurationIterations =
-          integerField(file, init["configuration_iterations"], "initialisation.configuration_iterations", 1);
+          yaml::integerAtLeast(file, init["configuration_iterations"], "initialisation.configuration_iterations", 1);
   }
-  if (root["refine"]) s.refineRounds = integerField(file, root["refine"], "refine", 0);
+  if (root["refine"]) s.refineRounds = yaml::integerAtLeast(file, root["refine"], "refine", 0);
   if (root["hessian"]) {
     const std::string hessian = yaml::text(file, root["hessian"], "hessian");
     try {
@@ -701,7 +427,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
           c.forContactForces.push_back(forces);
         }
       }
-      if (stage["max_iterations"]) c.maxIterations = integerField(file, stage["max_iterations"], field + ".max_iterations", 1);
+      if (stage["max_iterations"]) c.maxIterations = yaml::integerAtLeast(file, stage["max_iterations"], field + ".max_iterations", 1);
       if (stage["friction_sharpness"])
         c.frictionSharpness = yaml::positive(file, stage["friction_sharpness"], field + ".friction_sharpness");
       if (stage["smoothing"]) {
@@ -717,7 +443,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
           throw InputError(where(file, stage["samples"], field + ".samples") +
                            "the epigraph form and contact_forces: variables have variables per sample; a stage "
                            "cannot change the samples");
-        c.samples = integerField(file, stage["samples"], field + ".samples", 2);
+        c.samples = yaml::integerAtLeast(file, stage["samples"], field + ".samples", 2);
       }
       s.continuation.push_back(c);
     }
@@ -741,31 +467,5 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
 }
 
 }  // namespace
-
-Scenario withStagesForItsFormulation(const Scenario& scenario) {
-  Scenario kept = scenario;
-  kept.continuation.clear();
-  for (const Scenario::ContinuationStage& stage : scenario.continuation)
-    if (stage.runsWith(scenario.contactForces)) kept.continuation.push_back(stage);
-  return kept;
-}
-
-Scenario continuationStage(const Scenario& scenario, std::size_t k) {
-  Scenario stage = scenario;
-  stage.continuation.clear();
-  if (k < scenario.continuation.size()) {
-    stage.actuators.frictionSharpness = scenario.continuation[k].frictionSharpness;
-    stage.smoothing = scenario.continuation[k].smoothing;
-    stage.samples = scenario.continuation[k].samples;
-    stage.hessian = scenario.continuation[k].hessian;
-    stage.energyForm = scenario.continuation[k].energyForm;
-  }
-  return stage;
-}
-
-bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
-  return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
-         stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
-}
 
 }  // namespace mcopt

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "outer_nlp/scenario.hpp"
 
@@ -22,6 +23,17 @@ void readThrowTask(const std::filesystem::path& file, const YAML::Node& node, co
 /// What only the whole scenario decides: the release on a sample of the motion (and of every
 /// continuation stage's grid), and the ball on a body that is not a contact's.
 void checkThrowTask(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, const Scenario& s);
+
+/// The `contacts:` list (scenario_contacts.cpp): fills s.contacts, the reference contact
+/// first, and the closure tasks of the environment contacts. Needs the robot, the reference
+/// body and pose, the duration and the postures read.
+void readContacts(const std::filesystem::path& file, const YAML::Node& list, const std::vector<ContactSurface>& surfaces,
+                  Scenario& s);
+/// The `solver:` mapping of Ipopt options (scenario_settings.cpp), typed as YAML reads them.
+void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node, Scenario& s);
+/// The `inner:` settings (scenario_settings.cpp): solver, contact model, facets, tolerance,
+/// polishing, KKT backend.
+void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s);
 
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// How a scenario is solved, apart from what it asks (docs/reference/scenario-file.md): the
+// Ipopt options of `solver:`, the inner problem's `inner:` settings, the Hessian options by
+// name, and the continuation's stages.
+#include <cstdlib>
+
+#include "core/errors.hpp"
+#include "core/yaml_fields.hpp"
+#include "inner_qp/inner_solver.hpp"
+#include "outer_nlp/scenario_yaml.hpp"
+
+namespace mcopt {
+
+using yaml::where;
+
+void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
+  if (!node.IsMap()) throw InputError(where(file, node, "solver") + "expected a mapping of Ipopt options");
+  for (const auto& entry : node) {
+    const std::string name = entry.first.as<std::string>();
+    const std::string field = "solver." + name;
+    if (!entry.second.IsScalar()) throw InputError(where(file, entry.second, field) + "expected a scalar value");
+    SolverOption o;
+    o.name = name;
+    o.origin = where(file, entry.first, field);
+    o.text = entry.second.as<std::string>();
+    // YAML decides the type: 3000 is an integer, 1e-8 or 0.5 a number, anything else text.
+    char* endPointer = nullptr;
+    const long asLong = std::strtol(o.text.c_str(), &endPointer, 10);
+    if (!o.text.empty() && *endPointer == '\0') {
+      o.type = SolverOption::Type::Integer;
+      o.integer = static_cast<int>(asLong);
+    } else {
+      const double asDouble = std::strtod(o.text.c_str(), &endPointer);
+      if (!o.text.empty() && *endPointer == '\0') {
+        o.type = SolverOption::Type::Number;
+        o.number = asDouble;
+      }
+    }
+    s.solverOptions.push_back(o);
+  }
+}
+
+void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
+  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish"});
+  if (node["solver"]) {
+    const std::string name = yaml::text(file, node["solver"], "inner.solver");
+    if (!isInnerSolverName(name))
+      throw InputError(where(file, node["solver"], "inner.solver") + "unknown inner solver '" + name +
+                       "' (expected " + innerSolverList() + ")");
+    s.inner.solverName = name;
+  }
+  std::string modelName = s.inner.problem.model->name();
+  if (node["contact_model"]) {
+    modelName = yaml::text(file, node["contact_model"], "inner.contact_model");
+    if (!isContactModelName(modelName))
+      throw InputError(where(file, node["contact_model"], "inner.contact_model") + "unknown contact model '" +
+                       modelName + "' (expected " + contactModelList() + ")");
+  }
+  ContactModelOptions options;
+  if (node["pyramid_facets"]) {
+    if (modelName != "pyramid")
+      throw InputError(where(file, node["pyramid_facets"], "inner.pyramid_facets") +
+                       "only the pyramid contact model has facets (the contact model is " + modelName + ")");
+    options.pyramidFacets = yaml::integerAtLeast(file, node["pyramid_facets"], "inner.pyramid_facets", 3);
+  }
+  s.inner.problem.model = makeContactModel(modelName, options);
+  if (s.inner.problem.model->wrenchSize() < 6)
+    throw InputError(where(file, node["contact_model"], "inner.contact_model") + "the " + modelName +
+                     " model holds a force alone, no moment: give it to a contact (contacts[k].model: " + modelName +
+                     "), not to every contact — the reference contact carries moments");
+  if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
+  if (node["polish"]) s.inner.solver.polish = yaml::flag(file, node["polish"], "inner.polish");
+  if (node["kkt_backend"]) {
+    try {
+      s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));
+    } catch (const InputError& e) {
+      throw InputError(where(file, node["kkt_backend"], "inner.kkt_backend") + e.what());
+    }
+  }
+}
+
+namespace {
+struct HessianName {
+  HessianOption option;
+  const char* name;
+};
+constexpr HessianName kHessianNames[] = {{HessianOption::LimitedMemory, "limited-memory"},
+                                         {HessianOption::FiniteDifferences, "finite-differences"},
+                                         {HessianOption::SampleDifferences, "sample-differences"},
+                                         {HessianOption::ConvexSampleDifferences, "convex-sample-differences"},
+                                         {HessianOption::GaussNewton, "gauss-newton"},
+                                         {HessianOption::Exact, "exact"}};
+}  // namespace
+
+const char* toString(HessianOption hessian) {
+  for (const HessianName& h : kHessianNames)
+    if (h.option == hessian) return h.name;
+  return "?";
+}
+
+HessianOption parseHessianOption(const std::string& name) {
+  for (const HessianName& h : kHessianNames)
+    if (name == h.name) return h.option;
+  throw InputError("expected " + alternatives(hessianOptionNames()) + ", got '" + name + "'");
+}
+
+const std::vector<std::string>& hessianOptionNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const HessianName& h : kHessianNames) all.emplace_back(h.name);
+    return all;
+  }();
+  return names;
+}
+
+std::string exactHessianRefusal(const Scenario& s) {
+  if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
+    return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
+           "variables, or hessian: sample-differences";
+  if (!s.contacts.empty())
+    return "contact '" + s.contacts.front().surface.name + "' is held by construction, its loop's closing joints following the others "
+           "(docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no rule for that map; use "
+           "hessian: sample-differences or gauss-newton";
+  for (const Joint& joint : s.robot.joints)
+    if (joint.type == JointType::Prismatic)
+      return "prismatic joint '" + joint.name + "': its stencil assumes revolute joints";
+  if (s.energyForm == EnergyForm::Epigraph && s.duration.free())
+    return "the epigraph form with a free duration (its slack × duration term lies outside the Hessian's variables)";
+  return {};
+}
+
+Scenario withStagesForItsFormulation(const Scenario& scenario) {
+  Scenario kept = scenario;
+  kept.continuation.clear();
+  for (const Scenario::ContinuationStage& stage : scenario.continuation)
+    if (stage.runsWith(scenario.contactForces)) kept.continuation.push_back(stage);
+  return kept;
+}
+
+Scenario continuationStage(const Scenario& scenario, std::size_t k) {
+  Scenario stage = scenario;
+  stage.continuation.clear();
+  if (k < scenario.continuation.size()) {
+    stage.actuators.frictionSharpness = scenario.continuation[k].frictionSharpness;
+    stage.smoothing = scenario.continuation[k].smoothing;
+    stage.samples = scenario.continuation[k].samples;
+    stage.hessian = scenario.continuation[k].hessian;
+    stage.energyForm = scenario.continuation[k].energyForm;
+  }
+  return stage;
+}
+
+bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
+  return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
+         stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
+}
+
+}  // namespace mcopt
