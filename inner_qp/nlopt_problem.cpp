@@ -11,6 +11,9 @@
 
 namespace mcopt::inner_detail {
 
+// The adapter's own types and helpers: internal to this file.
+namespace {
+
 /// How NLopt sees the inner problem: x = wrenchUnit · y for its variables y, the objective
 /// divided by objectiveUnit and the constraints (all homogeneous of degree one in the wrenches
 /// but for their bounds) by wrenchUnit. 1 and 1: the problem as it is.
@@ -118,6 +121,8 @@ bool nloptStopped(int code) {
 std::string nloptMessage(int code) {
   return std::string("nlopt: ") + nlopt_result_to_string(static_cast<nlopt_result>(code));
 }
+
+}  // namespace
 
 NloptMethod augmentedLagrangian(int local) {
   NloptMethod method;
