@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include "core/no_malloc_scope.hpp"
+#include "core/sample_chunks.hpp"
 
 #include "core/errors.hpp"
 
@@ -17,10 +18,10 @@ TrajectoryGradientEvaluator::TrajectoryGradientEvaluator(const DynamicsModel& mo
     throw InputError("actuators, trajectory and robot disagree on the number of joints");
   workspaces_.assign(static_cast<std::size_t>(omp_get_max_threads()), ThreadWorkspace(model));
   const int n = model.jointCount(), p = samples_.parametrization().parameterCount();
-  for (ThreadWorkspace& w : workspaces_) {
-    w.energyGradient.setZero(p);
+  for (ThreadWorkspace& w : workspaces_)
     for (Eigen::VectorXd* v : {&w.powerTorque, &w.rowQ, &w.rowV, &w.rowA}) v->setZero(n);
-  }
+  chunkSums_.resize(static_cast<std::size_t>(sampleChunkCount(samples_.sampleCount())));
+  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(p);
 }
 
 void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
@@ -30,19 +31,17 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
   prepareTrajectoryResult(samples_, n, parameters, duration, r);
   g.torque.resize(static_cast<std::size_t>(count));
   parametrization.controlPoints(parameters, controlPoints_);
-  for (ThreadWorkspace& w : workspaces_) {
-    w.energyGradient.setZero();
-    w.energyDT = 0.0;
-  }
+  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(), sum.energyDT = 0.0;
   const double dt = duration / (count - 1);
 
   // Each sample's Jacobian block is sized by its first evaluation: checked once they all are.
   bool sized = true;
   for (const SampleTorqueJacobian& block : g.torque) sized = sized && block.dtauDx.size() > 0;
   const NoMallocScope perSample("trajectory gradient", sized);
-#pragma omp parallel for schedule(static)
-  for (int s = 0; s < count; ++s) {
+#pragma omp parallel
+  forEachSampleInChunks(count, [&](int s, int) {
     ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    ChunkSum& sum = chunkSums_[static_cast<std::size_t>(s / kSampleChunk)];
     r.time[s] = samples_.time(s, duration);
     samples_.evaluate(s, controlPoints_, duration, r.q.col(s), r.v.col(s), r.a.col(s));
     inverseDynamicsDerivatives(model_, w.data, w.derivatives, r.q.col(s), r.v.col(s), r.a.col(s));
@@ -79,18 +78,18 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
     w.rowA.noalias() += d.dtauDa.transpose() * w.powerTorque;
     for (int j = 0; j < n; ++j)
       for (int l = 0; l < k; ++l)
-        w.energyGradient[j * m + weights.parameter[l]] += w.rowQ[j] * weights.value[l] +
+        sum.energyGradient[j * m + weights.parameter[l]] += w.rowQ[j] * weights.value[l] +
                                                          w.rowV[j] * weights.d1[l] / duration +
                                                          w.rowA[j] * weights.d2[l] / (duration * duration);
     // ∂/∂T: the weight Δt ∝ T, and q̇, q̈ scale as 1/T, 1/T² (through Γ too).
-    w.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(block.dtauDT);
-  }
+    sum.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(block.dtauDT);
+  });
   r.energy = positiveEnergy(r.power, r.time);
   g.energyGradient.setZero(parametrization.parameterCount());
   g.energyDT = 0.0;
-  for (const ThreadWorkspace& w : workspaces_) {
-    g.energyGradient += w.energyGradient;
-    g.energyDT += w.energyDT;
+  for (const ChunkSum& sum : chunkSums_) {
+    g.energyGradient += sum.energyGradient;
+    g.energyDT += sum.energyDT;
   }
 }
 

@@ -45,7 +45,12 @@ class TrajectoryGradientEvaluator {
     explicit ThreadWorkspace(const DynamicsModel& model) : data(model), derivatives(model) {}
     DynamicsData data;
     DynamicsDerivatives derivatives;
-    Eigen::VectorXd energyGradient, powerTorque, rowQ, rowV, rowA;
+    Eigen::VectorXd powerTorque, rowQ, rowV, rowA;
+  };
+  /// A chunk's share of the energy's gradient (core/sample_chunks.hpp): summed over the chunks
+  /// in order, the same for any thread count.
+  struct ChunkSum {
+    Eigen::VectorXd energyGradient;
     double energyDT = 0.0;
   };
   const DynamicsModel& model_;
@@ -53,6 +58,7 @@ class TrajectoryGradientEvaluator {
   SampledTrajectory samples_;
   Eigen::MatrixXd controlPoints_;
   std::vector<ThreadWorkspace> workspaces_;
+  std::vector<ChunkSum> chunkSums_;
 };
 
 }  // namespace mcopt

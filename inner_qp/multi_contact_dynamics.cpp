@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include "core/no_malloc_scope.hpp"
+#include "core/sample_chunks.hpp"
 
 #include "core/errors.hpp"
 #include "core/inverse_dynamics.hpp"
@@ -170,23 +171,20 @@ void MultiContactEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& pa
   const NoMallocScope perSample("inner solves", sized_ && capture_ == nullptr);  // copying problems out allocates
 #pragma omp parallel num_threads(threads)
   {
-    // One contiguous block of samples per thread: the warm start follows the motion.
-    const int t = omp_get_thread_num(), used = omp_get_num_threads();
-    const int first = count * t / used, last = count * (t + 1) / used;
-    Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
-    InnerResult* before = nullptr;
-    for (int s = first; s < last; ++s) {
+    Workspace& w = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    // The samples in fixed chunks (core/sample_chunks.hpp): a sample starts from its own result
+    // of the previous evaluation or, without one, from its predecessor's in the chunk.
+    forEachSampleInChunks(count, [&](int s, int predecessor) {
       InnerResult& current = previous_[static_cast<std::size_t>(s)];
-      // Within a block, the previous sample's result is the better start.
-      if (before != nullptr && settings_.solver.warmStart) {
-        current.wrenches = before->wrenches;
-        current.activeSet = before->activeSet;
-        current.inequalityMultipliers = before->inequalityMultipliers;
-        current.coneMultipliers = before->coneMultipliers;
+      if (predecessor >= 0 && settings_.solver.warmStart && current.wrenches.size() == 0) {
+        const InnerResult& before = previous_[static_cast<std::size_t>(predecessor)];
+        current.wrenches = before.wrenches;
+        current.activeSet = before.activeSet;
+        current.inequalityMultipliers = before.inequalityMultipliers;
+        current.coneMultipliers = before.coneMultipliers;
       }
       evaluateSample(w, s, duration, r);
-      before = &current;
-    }
+    });
   }
   r.innerTimeUs = 0.0;
   r.infeasibleSamples = r.failedSamples = 0;

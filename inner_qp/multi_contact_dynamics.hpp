@@ -3,9 +3,10 @@
 // The multi-contact "dynamic model" of the report's Figure 5.2: a whole motion, splines →
 // (q, q̇, q̈) → Newton–Euler at the fixed reference body (Γ0, W0) → at every sample the inner
 // problem picks the contact wrenches (formulation.md §5, §7) → Γ = Γ0 − J1 F → motor power →
-// energy. Samples are split into one contiguous block per thread; within a block each
-// sample's inner solve is warm-started from the previous sample, the block's first from the
-// same sample of the previous evaluation. Allocation-free after construction.
+// energy. The samples run in the fixed chunks of core/sample_chunks.hpp, as in the motion
+// problem: each sample's inner solve starts from its own result of the previous evaluation or,
+// on the first, from its predecessor's in the chunk; the results do not depend on the thread
+// count. Allocation-free after construction.
 
 #include <Eigen/Core>
 #include <memory>
@@ -23,7 +24,7 @@ namespace mcopt {
 struct MultiContactSettings {
   ContactProblemSettings problem;
   InnerSettings solver;
-  std::string solverName = "active-set";  ///< active-set, slsqp or ipopt
+  std::string solverName = "active-set";  ///< a registered inner solver (innerSolverNames())
 };
 
 /// A robot's contact surface as an inner-problem contact (f_min = 0), at `pose` in the world

@@ -11,6 +11,7 @@
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
 #include "core/no_malloc_scope.hpp"
+#include "core/sample_chunks.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
@@ -19,10 +20,6 @@
 namespace mcopt {
 
 namespace {
-
-/// Samples a thread evaluates in order, warm-starting each bilevel sample from the one before
-/// on the first evaluation: fixed, so that no result depends on the thread count.
-constexpr int kWarmStartChunk = 8;
 
 std::vector<double> taskInstants(const Scenario& s, std::vector<int>& taskOfInstant) {
   // Instants are fractions of the motion: with a free duration a task keeps its phase.
@@ -354,11 +351,6 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   if (closure_ && !closureStarted_) startClosureAlongTheMotion(controlPoints_, T);
   const int count = samples_.sampleCount(), taskCount = static_cast<int>(taskBlocks_.size());
   const int threads = static_cast<int>(workspaces_.size());
-  // Fixed chunks of consecutive samples, each evaluated in order by one thread: a bilevel
-  // sample without a result of its own (the first evaluation) is warm-started from its
-  // predecessor in the chunk. The chunks, not the thread count, decide every warm start, so
-  // the results are the same, to the bit, for any thread count (docs/developers/determinism.md, "Determinism").
-  const int chunks = (count + kWarmStartChunk - 1) / kWarmStartChunk;
   {
     // After the first evaluation of its kind every buffer is sized: no Eigen allocation here
     // (debug builds check; tests/core/test_no_allocation.cpp counts every allocation).
@@ -366,15 +358,15 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
 #pragma omp parallel num_threads(threads)
     {
       ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
-#pragma omp for schedule(static)
-      for (int chunk = 0; chunk < chunks; ++chunk) {
-        const int first = chunk * kWarmStartChunk, last = std::min(count, first + kWarmStartChunk);
-        for (int s = first; s < last; ++s) {
-          if (bilevel_ && s > first && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
-            bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(s - 1)]);
-          evaluateSample(s, x, T, derivatives, w);
-        }
-      }
+      // The samples in fixed chunks (core/sample_chunks.hpp): a bilevel sample without a result
+      // of its own (the first evaluation) is warm-started from its predecessor in the chunk, so
+      // the results are the same, to the bit, for any thread count
+      // (docs/developers/determinism.md).
+      forEachSampleInChunks(count, [&](int s, int predecessor) {
+        if (bilevel_ && predecessor >= 0 && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
+          bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(predecessor)]);
+        evaluateSample(s, x, T, derivatives, w);
+      });
 #pragma omp for schedule(static)
       for (int i = 0; i < taskCount; ++i) evaluateTaskInstant(i, T, derivatives, w);
     }

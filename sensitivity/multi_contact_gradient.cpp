@@ -8,6 +8,7 @@
 
 #include "core/errors.hpp"
 #include "core/no_malloc_scope.hpp"
+#include "core/sample_chunks.hpp"
 #include "sensitivity/sparse_kkt_factor.hpp"
 
 namespace mcopt {
@@ -19,8 +20,7 @@ struct MultiContactGradientEvaluator::Workspace {
   }
   DynamicsData data;
   DynamicsDerivatives derivatives;
-  Eigen::VectorXd energyGradient, powerTorque, rowQ, rowV, rowA;
-  double energyDT = 0.0;
+  Eigen::VectorXd powerTorque, rowQ, rowV, rowA;
   int degenerate = 0, withoutDerivative = 0;
 };
 
@@ -123,7 +123,7 @@ void MultiContactGradientEvaluator::solveAllSamples() {
 }
 
 void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double duration, MultiContactResult& r,
-                                                 MultiContactGradient& grad) {
+                                                 MultiContactGradient& grad, ChunkSum& sum) {
   const int n = model_.jointCount();
   const int count = samples_.sampleCount(), m = samples_.parametrization().parametersPerJoint();
   TrajectoryResult& motion = r.motion;
@@ -165,11 +165,11 @@ void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double dur
   w.rowA.noalias() += sample.torqueDa().transpose() * w.powerTorque;
   for (int j = 0; j < n; ++j)
     for (int l = 0; l < local.count; ++l)
-      w.energyGradient[j * m + local.parameter[static_cast<std::size_t>(l)]] +=
+      sum.energyGradient[j * m + local.parameter[static_cast<std::size_t>(l)]] +=
           w.rowQ[j] * local.value[static_cast<std::size_t>(l)] +
           w.rowV[j] * local.d1[static_cast<std::size_t>(l)] / duration +
           w.rowA[j] * local.d2[static_cast<std::size_t>(l)] / (duration * duration);
-  w.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(torqueBlock.dtauDT);
+  sum.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(torqueBlock.dtauDT);
 }
 
 void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
@@ -189,11 +189,9 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   grad.wrenches.resize(static_cast<std::size_t>(count));
   grad.diagnostics.resize(static_cast<std::size_t>(count));
   samples_.parametrization().controlPoints(parameters, controlPoints_);
-  for (auto& w : workspaces_) {
-    w->energyGradient.setZero(parameterCount);
-    w->energyDT = 0.0;
-    w->degenerate = w->withoutDerivative = 0;
-  }
+  for (auto& w : workspaces_) w->degenerate = w->withoutDerivative = 0;
+  chunkSums_.resize(static_cast<std::size_t>(sampleChunkCount(count)));
+  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(parameterCount), sum.energyDT = 0.0;
   const int threads = static_cast<int>(workspaces_.size());
   // Once every sample's buffers are sized by a first evaluation, the per-sample path —
   // dynamics, inner solve, KKT assembly, factorisation and solve, chain rule — makes no Eigen
@@ -209,16 +207,14 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   perSample.emplace("sensitivity", armed && perSampleLayout);
 #pragma omp parallel num_threads(threads)
   {
-    // One contiguous block of samples per thread: a sample without a result of its own (the
-    // first evaluation) is warm-started from its predecessor in the block.
-    const int t = omp_get_thread_num(), used = omp_get_num_threads();
-    const int first = count * t / used, last = count * (t + 1) / used;
-    Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
-    for (int s = first; s < last; ++s) {
-      if (s > first && settings_.solver.warmStart && !bilevel_[static_cast<std::size_t>(s)].hasResult())
-        bilevel_[static_cast<std::size_t>(s)].warmStartFrom(bilevel_[static_cast<std::size_t>(s - 1)]);
+    // The samples in fixed chunks (core/sample_chunks.hpp): a sample without a result of its
+    // own (the first evaluation) is warm-started from its predecessor in the chunk.
+    Workspace& w = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    forEachSampleInChunks(count, [&](int s, int predecessor) {
+      if (predecessor >= 0 && settings_.solver.warmStart && !bilevel_[static_cast<std::size_t>(s)].hasResult())
+        bilevel_[static_cast<std::size_t>(s)].warmStartFrom(bilevel_[static_cast<std::size_t>(predecessor)]);
       prepareSample(w, s, duration, r, grad);
-    }
+    });
   }
   if (!perSampleLayout) {
     perSample.reset();
@@ -227,10 +223,12 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   }
 #pragma omp parallel num_threads(threads)
   {
-    const int t = omp_get_thread_num(), used = omp_get_num_threads();
-    const int first = count * t / used, last = count * (t + 1) / used;
-    Workspace& w = *workspaces_[static_cast<std::size_t>(t)];
-    for (int s = first; s < last; ++s) finishSample(w, s, duration, r, grad);
+    // The energy's gradient is summed per chunk, then over the chunks in order: the same sums
+    // in the same order for any thread count.
+    Workspace& w = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
+    forEachSampleInChunks(count, [&](int s, int) {
+      finishSample(w, s, duration, r, grad, chunkSums_[static_cast<std::size_t>(s / kSampleChunk)]);
+    });
   }
   perSample.reset();
   sized_ = true;
@@ -245,9 +243,11 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   grad.torqueAndEnergy.energyGradient.setZero(parameterCount);
   grad.torqueAndEnergy.energyDT = 0.0;
   grad.degenerateSamples = grad.samplesWithoutDerivative = 0;
+  for (const ChunkSum& sum : chunkSums_) {
+    grad.torqueAndEnergy.energyGradient += sum.energyGradient;
+    grad.torqueAndEnergy.energyDT += sum.energyDT;
+  }
   for (const auto& w : workspaces_) {
-    grad.torqueAndEnergy.energyGradient += w->energyGradient;
-    grad.torqueAndEnergy.energyDT += w->energyDT;
     grad.degenerateSamples += w->degenerate;
     grad.samplesWithoutDerivative += w->withoutDerivative;
   }

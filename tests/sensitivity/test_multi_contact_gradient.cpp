@@ -2,10 +2,13 @@
 // The multi-contact gradient (formulation.md §8, (4.8)): sampled torques, contact wrenches and
 // the energy differentiated w.r.t. the spline parameters and the duration, against central
 // differences of the multi-contact dynamic model itself.
+#include <omp.h>
+
 #include <catch2/catch.hpp>
 
 #include "common/robots.hpp"
 #include "core/errors.hpp"
+#include "core/trajectory_gradient.hpp"
 #include "sensitivity/multi_contact_gradient.hpp"
 
 using namespace mcopt;
@@ -285,4 +288,57 @@ TEST_CASE("per-sample KLU and UMFPACK keep each pattern's analysis along the ite
     CHECK(reused >= 45);  // the active sets hold at most samples from one small step to the next
     CHECK(solvedByBackend >= 70);  // of 80: near-singular samples alone go to the dense least-norm solve
   }
+}
+
+TEST_CASE("the multi-contact evaluators and the trajectory gradient give the same bits with 1 and 2 threads",
+          "[sensitivity][gradient][determinism]") {
+  // One rule for every loop over the samples (core/sample_chunks.hpp): fixed chunks decide the
+  // warm starts and the order of the energy gradient's sums, not the thread count. 21 samples:
+  // three chunks, the last one short. Two evaluations each: the first warm-starts from the
+  // predecessors, the second from each sample's own answer at a moved motion.
+  Setup hrp2;
+  const DynamicsModel model(hrp2.robot, "l_sole");
+  const MotionParametrization parametrization(hrp2.robot.jointCount());
+  std::mt19937 rng(431);
+  const Eigen::VectorXd x0 = parametrization.constantMotion(hrp2.halfSitting) +
+                             0.01 * test::randomVector(rng, parametrization.parameterCount(), 1.0);
+  const Eigen::VectorXd x1 = x0 + 0.003 * test::randomVector(rng, parametrization.parameterCount(), 1.0);
+  struct Outcome {
+    Eigen::MatrixXd tau, wrenches, gradientTau, oneContactTau;
+    Eigen::VectorXd energyGradient, oneContactGradient;
+    double energy = 0.0, energyDT = 0.0, oneContactDT = 0.0;
+  };
+  const int before = omp_get_max_threads();
+  auto run = [&](int threads) {
+    omp_set_num_threads(threads);
+    Outcome o;
+    MultiContactEvaluator values(model, hrp2.actuators, SampledTrajectory(parametrization, 21), hrp2.contacts(3));
+    MultiContactGradientEvaluator gradients(model, hrp2.actuators, SampledTrajectory(parametrization, 21), hrp2.contacts(3));
+    TrajectoryGradientEvaluator oneContact(model, hrp2.actuators, SampledTrajectory(parametrization, 21));
+    MultiContactResult r, g;
+    MultiContactGradient gradient;
+    TrajectoryResult one;
+    TrajectoryGradient oneGradient;
+    for (const Eigen::VectorXd* x : {&x0, &x1}) {
+      values.evaluate(*x, 1.4, r);
+      gradients.evaluate(*x, 1.4, g, gradient);
+      oneContact.evaluate(*x, 1.4, one, oneGradient);
+    }
+    o.tau = r.motion.tau, o.wrenches = r.wrenches, o.energy = r.motion.energy;
+    o.gradientTau = g.motion.tau, o.energyGradient = gradient.torqueAndEnergy.energyGradient;
+    o.energyDT = gradient.torqueAndEnergy.energyDT;
+    o.oneContactTau = one.tau, o.oneContactGradient = oneGradient.energyGradient, o.oneContactDT = oneGradient.energyDT;
+    return o;
+  };
+  const Outcome one = run(1), two = run(2);
+  omp_set_num_threads(before);
+  CHECK(one.tau == two.tau);
+  CHECK(one.wrenches == two.wrenches);
+  CHECK(one.energy == two.energy);
+  CHECK(one.gradientTau == two.gradientTau);
+  CHECK(one.energyGradient == two.energyGradient);
+  CHECK(one.energyDT == two.energyDT);
+  CHECK(one.oneContactTau == two.oneContactTau);
+  CHECK(one.oneContactGradient == two.oneContactGradient);
+  CHECK(one.oneContactDT == two.oneContactDT);
 }
