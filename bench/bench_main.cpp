@@ -8,7 +8,7 @@
 namespace mcopt::bench {
 void registerDynamicsBenchmarks();
 void registerInnerBenchmarks();
-void registerSensitivityBenchmarks();
+void registerBilevelBenchmarks();
 void registerOptimisationBenchmarks();
 void registerOuterHessianBenchmarks();
 }
@@ -19,7 +19,7 @@ int main(int argc, char** argv) {
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
   mcopt::bench::registerDynamicsBenchmarks();
   mcopt::bench::registerInnerBenchmarks();
-  mcopt::bench::registerSensitivityBenchmarks();
+  mcopt::bench::registerBilevelBenchmarks();
   mcopt::bench::registerOptimisationBenchmarks();
   mcopt::bench::registerOuterHessianBenchmarks();
   benchmark::Initialize(&argc, argv);

@@ -2,7 +2,7 @@
 // OuterHessian/Kick100/hrp2/<option>: one evaluation of the Lagrangian's Hessian of the
 // bundled kick's motion problem (100 samples, 150 spline parameters) at its initial motion,
 // with unit multipliers, for each `hessian:` option that evaluates one (docs/theory/outer-problem.md,
-// "Hessian and convergence"); beside it Gradient/OneContact100/hrp2 (bench_sensitivity.cpp)
+// "Hessian and convergence"); beside it Gradient/OneContact100/hrp2 (bench_dynamics.cpp)
 // and the whole problem's gradient and Jacobian (OuterGradient/Kick100/hrp2), the unit
 // these options are counted in. OuterGradient/weight_shift/<formulation>[/<inner solver>]:
 // the same on the bundled weight shift for each contact-force formulation (formulation.md §9).

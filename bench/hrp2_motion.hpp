@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// The HRP-2 motion of the multi-contact benchmarks (Inner/*, BilevelDynamics/*, BilevelGradient/*).
+// The HRP-2 motion whose samples give the inner solvers' benchmark its problems (Inner/*).
 #include <filesystem>
 #include <random>
 #include <vector>

@@ -13,8 +13,8 @@ import pytest
 from conftest import SOURCE, run_cli
 
 FIGURE_5_1 = ["InverseDynamics/Trajectory100/hrp2", "Gradient/OneContact100/hrp2"]
-FIGURE_5_2 = ["BilevelDynamics/TwoContacts100/hrp2", "BilevelDynamics/TwoContacts100/hrp2/slsqp",
-              "BilevelDynamics/TwoContacts100/hrp2/ipopt", "BilevelGradient/TwoContacts100/hrp2/dense",
+FIGURE_5_2 = ["BilevelDynamics/WeightShift100/hrp2", "BilevelDynamics/WeightShift100/hrp2/slsqp",
+              "BilevelDynamics/WeightShift100/hrp2/ipopt", "BilevelGradient/WeightShift100/hrp2/dense",
               "OuterGradient/weight_shift/bilevel/active-set", "OuterGradient/weight_shift/bilevel/slsqp",
               "OuterGradient/weight_shift/bilevel/ipopt", "OuterGradient/weight_shift/splines",
               "OuterGradient/weight_shift/variables"]
