@@ -30,7 +30,7 @@ set(mcopt_private_headers
   core/atomic_file.hpp
   inner_qp/answer_polishing.hpp inner_qp/inner_nlp.hpp inner_qp/nlopt_problem.hpp inner_qp/dual_active_set_qp.hpp
   sensitivity/sparse_kkt_factor.hpp
-  outer_nlp/motion_workspace.hpp outer_nlp/scenario_yaml.hpp outer_nlp/smooth_maximum.hpp
+  outer_nlp/motion_workspace.hpp outer_nlp/contact_force_formulation.hpp outer_nlp/scenario_yaml.hpp outer_nlp/smooth_maximum.hpp
   study/child_process.hpp study/scenario_tree.hpp)
 foreach(library ${mcopt_installed_libraries})
   file(GLOB headers RELATIVE ${PROJECT_SOURCE_DIR} CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/${library}/*.hpp)

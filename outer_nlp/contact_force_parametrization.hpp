@@ -17,6 +17,14 @@
 
 namespace mcopt {
 
+/// One parametrisation term among a sample's local force columns: its contact, its weight and
+/// its first local column (the wrench's six components follow).
+struct LocalForceTerm {
+  int contact = 0;
+  double weight = 0.0;
+  int firstColumn = 0;
+};
+
 class ContactForceParametrization {
  public:
   struct Term {
@@ -32,6 +40,7 @@ class ContactForceParametrization {
 
   int contactCount() const { return static_cast<int>(windows_.size()); }
   int variableCount() const { return variableCount_; }
+  int sampleCount() const { return terms_.empty() ? 0 : static_cast<int>(terms_.front().size()); }
   bool active(int contact, int sample) const { return !terms(contact, sample).empty(); }
   /// Empty when the contact is not in contact at that sample.
   const std::vector<Term>& terms(int contact, int sample) const {

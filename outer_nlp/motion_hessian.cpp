@@ -66,7 +66,7 @@ void MotionProblem::referenceWrenchJacobian(int s, const ThreadWorkspace& w,
   jacobian.leftCols(n) = w.referenceDq;
   jacobian.middleCols(n, n) = w.derivatives.dwrenchDv;
   jacobian.middleCols(2 * n, n) = w.derivatives.dwrenchDa;
-  for (const SampleBlock::ForceTerm& t : blocks_[static_cast<std::size_t>(s)].forceTerms)
+  for (const LocalForceTerm& t : blocks_[static_cast<std::size_t>(s)].forceTerms)
     jacobian.middleCols<6>(3 * n + t.firstColumn) = -t.weight * w.toWorld[static_cast<std::size_t>(t.contact)];
 }
 
@@ -95,8 +95,8 @@ void MotionProblem::sampleExactHessian(int s, const SampleBlock& b, const Eigen:
     H.noalias() += multipliers[outputs_.referenceRow(support_.quadraticRow())] * J.transpose() * CJ;
     // An environment contact's wrench F_i = Σ_t weight_t z_t: its rows' curvature on each
     // pair of its own terms.
-    for (const SampleBlock::ForceTerm& a : b.forceTerms)
-      for (const SampleBlock::ForceTerm& c : b.forceTerms) {
+    for (const LocalForceTerm& a : b.forceTerms)
+      for (const LocalForceTerm& c : b.forceTerms) {
         if (a.contact != c.contact) continue;
         const ContactAdmissibilityRows& rows = contactRows_[static_cast<std::size_t>(a.contact)];
         H.block<6, 6>(3 * n + a.firstColumn, 3 * n + c.firstColumn) +=

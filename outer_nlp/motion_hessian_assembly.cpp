@@ -22,9 +22,9 @@
 #include <cmath>
 
 #include "outer_nlp/ball_flight_task.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
@@ -260,7 +260,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       }
       // A bilevel sample keeps its last inner solution (its warm start, its reported status):
       // leave it at the unperturbed state.
-      if (bilevel_) sampleOutputs(s, h.probeX, false, w, probe);
+      if (formulation_->keepsSampleState()) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
       spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, nullptr, 0);
     }

@@ -17,6 +17,7 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
 #include "sensitivity/bilevel_sample.hpp"
 
@@ -100,9 +101,9 @@ Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParamete
     for (int l = 0; l < m; ++l)
       if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) x[j * m + l] = scenario_.start[j];  // (variableBounds)
   if (durationIsFree()) x[parameterCount_] = T;
-  if (forces_ && forceVariables != nullptr) {
+  if (forceVariableCount() > 0 && forceVariables != nullptr) {
     x.segment(forceStart_, forceVariableCount()) = *forceVariables;
-  } else if (forces_) {
+  } else if (forceVariableCount() > 0) {
     // The inner problem's wrenches along the initial motion: an admissible start, and the
     // bilevel optimum's forces are a feasible point of these formulations (formulation.md §9).
     std::vector<Eigen::MatrixXd> wrenches(scenario_.contacts.size(), Eigen::MatrixXd::Zero(6, samples_.sampleCount()));
@@ -127,7 +128,7 @@ Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParamete
             sample->problem().problem.contactWrench(sample->innerResult().wrenches, 1 + static_cast<int>(k));
       previous = std::move(sample);
     }
-    forces_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
+    formulation_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
   }
   setSlacksAtPower(x);
   return x;
@@ -145,11 +146,11 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
   if (other.scenario_.contactForces != scenario_.contactForces || other.parameterCount_ != parameterCount_ ||
       (other.forceVariableCount() != 0) != (forceVariableCount() != 0))
     throw std::invalid_argument("pointWithWrenchesFrom: not the same scenario on another grid");
-  if (!forces_ || scenario_.contactForces == ContactForces::Bilevel) return pointFromMotion(other.motionParameters(x), other.duration(x));
+  if (forceVariableCount() == 0) return pointFromMotion(other.motionParameters(x), other.duration(x));
   Eigen::VectorXd y = Eigen::VectorXd::Zero(variableCount_);
   y.head(parameterCount_) = other.motionParameters(x);
   if (durationIsFree()) y[parameterCount_] = other.duration(x);
-  if (scenario_.contactForces == ContactForces::Splines) {
+  if (formulation_->variablesIndependentOfGrid()) {
     if (other.forceVariableCount() != forceVariableCount())
       throw std::invalid_argument("pointWithWrenchesFrom: force splines of another size");
     y.segment(forceStart_, forceVariableCount()) = x.segment(other.forceStart_, other.forceVariableCount());
@@ -182,7 +183,7 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
         wrenches[i].col(s) = (1.0 - t) * b0.wrenches.segment<6>(at) + t * b1.wrenches.segment<6>(at);
       }
     }
-    forces_->fit(wrenches, y.segment(forceStart_, forceVariableCount()));
+    formulation_->fit(wrenches, y.segment(forceStart_, forceVariableCount()));
   }
   setSlacksAtPower(y);
   return y;

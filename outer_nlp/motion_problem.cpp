@@ -14,8 +14,8 @@
 #include "core/sample_chunks.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
@@ -187,19 +187,14 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     contactRows_.emplace_back(c.surface, RigidTransform{}, weight_, scenario_.inner.problem);
     outputs_.contactRowStart.push_back(outputs_.contactRowStart.back() + contactRows_.back().rowCount());
   }
-  // With the reference contact alone the wrench is W0 whatever the formulation (§5).
-  bilevel_ = contacts > 0 && scenario_.contactForces == ContactForces::Bilevel;
-  if (contacts > 0 && !bilevel_)
-    forces_ = std::make_unique<ContactForceParametrization>(scenario_.contactForces, windows_,
-                                                            sampleTimes_, active_, scenario_.forceControlPoints,
-                                                            forceStart_);
+  // How the environment contacts' wrenches are chosen (contact_force_formulation.hpp).
+  FormulationContext formulation{scenario_, outputs_, support_,    contactRows_, windows_, sampleTimes_,
+                                 active_,   forceStart_, weight_, {},           {}};
+  for (int s = 0; s < count; ++s)
+    formulation.sampleModels.push_back(&modelOf(s)), formulation.sampleSurfaces.push_back(surfacesInContact(s));
+  formulation_ = makeContactForceFormulation(formulation);
   slackStart_ = forceStart_ + forceVariableCount();
   variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * count : 0);
-  if (bilevel_) {
-    for (int s = 0; s < count; ++s)
-      bilevelSamples_.push_back(std::make_unique<BilevelSample>(modelOf(s), surfacesInContact(s), scenario_.inner,
-                                                                scenario_.sensitivity, weight_));
-  }
 
   for (int j = 0; j < jointCount_; ++j)
     if (scenario_.torqueLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit))
@@ -217,12 +212,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
     b.y.setZero(outputs), b.dyDT.setZero(outputs), b.wrenches.setZero(6 * (1 + contacts));
     b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
-    // Local force columns: every term of every contact in contact here, six components each.
-    for (int i = 0; forces_ && i < contacts; ++i)
-      for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) {
-        b.forceTerms.push_back({i, t.weight, static_cast<int>(b.forceColumns.size())});
-        for (int c = 0; c < 6; ++c) b.forceColumns.push_back(t.variable + c);
-      }
+    formulation_->layOutForceColumns(s, b.forceTerms, b.forceColumns);
     b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
     b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
@@ -255,7 +245,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     allJoints_.push_back(i);
     for (int j = 0; j < jointCount_; ++j)
       // Through a closure every output may depend on every joint (its map's columns).
-      if (bilevel_ || closure_ || model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
+      if (formulation_->innerProblem() || closure_ || model_.supports(i, model_.positionOfJoint(j)) || model_.supports(j, model_.positionOfJoint(i)))
         relatedJoints_[static_cast<std::size_t>(i)].push_back(j);
   }
   for (const int t : taskOfInstant_) {
@@ -288,7 +278,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       for (int l = 0; l < m && closure_->closes(j); ++l)
         unusedParameter_[static_cast<std::size_t>(j * m + l)] = !used[static_cast<std::size_t>(j * m + l)];
   }
-  terms_ = makeConstraintTerms(TermContext{scenario_, parametrization_, outputs_, closure_.get(), support_, contactRows_, bilevel_,
+  terms_ = makeConstraintTerms(TermContext{scenario_, parametrization_, outputs_, closure_.get(), support_, contactRows_, formulation_->innerProblem(),
                                            relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_,
                                            taskOfInstant_});
   costs_ = makeCostTerms(CostContext{scenario_, outputs_, closure_.get(), parametrization_, samples_, slackStart_});
@@ -296,6 +286,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
 }
 
 MotionProblem::~MotionProblem() = default;
+
+bool MotionProblem::bilevel() const { return formulation_->innerProblem(); }
+
+int MotionProblem::forceVariableCount() const { return formulation_->variableCount(); }
 
 bool MotionProblem::contactActive(int contact, int sample) const {
   return active_[static_cast<std::size_t>(contact)][static_cast<std::size_t>(sample)];
@@ -329,8 +323,12 @@ int MotionProblem::omittedTorqueRowCount() const {
 
 MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
   InnerStatistics statistics;
-  for (const auto& sample : bilevelSamples_) {
-    const InnerResult& r = sample->innerResult();
+  int samples = 0;
+  for (int s = 0; s < samples_.sampleCount(); ++s) {
+    const InnerResult* inner = formulation_->innerResult(s);
+    if (inner == nullptr) continue;
+    const InnerResult& r = *inner;
+    ++samples;
     statistics.optimal += r.status == InnerStatus::Optimal;
     statistics.infeasible += r.status == InnerStatus::Infeasible;
     statistics.failed += r.status == InnerStatus::Failed;
@@ -338,7 +336,7 @@ MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
     statistics.meanIterations += r.iterations;
     statistics.solveSeconds += 1e-6 * r.solveTimeUs;
   }
-  if (!bilevelSamples_.empty()) statistics.meanIterations /= static_cast<double>(bilevelSamples_.size());
+  if (samples > 0) statistics.meanIterations /= static_cast<double>(samples);
   return statistics;
 }
 
@@ -359,12 +357,11 @@ void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
     {
       ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
       // The samples in fixed chunks (core/sample_chunks.hpp): a bilevel sample without a result
-      // of its own (the first evaluation) is warm-started from its predecessor in the chunk, so
-      // the results are the same, to the bit, for any thread count
+      // of its own (the first evaluation) is warm-started from its predecessor in the chunk
+      // (beforeSample), so the results are the same, to the bit, for any thread count
       // (docs/developers/determinism.md).
       forEachSampleInChunks(count, [&](int s, int predecessor) {
-        if (bilevel_ && predecessor >= 0 && !bilevelSamples_[static_cast<std::size_t>(s)]->hasResult())
-          bilevelSamples_[static_cast<std::size_t>(s)]->warmStartFrom(*bilevelSamples_[static_cast<std::size_t>(predecessor)]);
+        formulation_->beforeSample(s, predecessor);
         evaluateSample(s, x, T, derivatives, w);
       });
 #pragma omp for schedule(static)

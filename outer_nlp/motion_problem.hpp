@@ -9,7 +9,7 @@
 //
 // Contacts (formulation.md §5, §9): the reference body's surface carries the robot at every
 // instant; every other contact (scenario `contacts`) is fixed in the world over its window.
-// Its wrench comes from the scenario's contact-force formulation:
+// Its wrench comes from the scenario's contact-force formulation (contact_force_formulation.hpp):
 //   bilevel    an inner problem per sample over the contacts active there picks them
 //              (sensitivity/bilevel_sample.hpp); exact gradients through its KKT system;
 //   splines / variables   they are linear in z (contact_force_parametrization.hpp) and the
@@ -72,7 +72,7 @@
 
 namespace mcopt {
 
-class BilevelSample;
+class ContactForceFormulation;  // outer_nlp/contact_force_formulation.hpp
 struct MotionWorkspace;  // outer_nlp/motion_workspace.hpp
 
 /// A thrown ball at its release (formulation.md §10), from the motion's q, q̇ at t_r by
@@ -143,8 +143,8 @@ class MotionProblem final : public NlpProblem {
   const SampledTrajectory& samples() const { return samples_; }
   bool durationIsFree() const { return scenario_.duration.free(); }
   /// The formulation in use: with the reference contact alone there are no contact forces to choose.
-  bool bilevel() const { return bilevel_; }
-  int forceVariableCount() const { return forces_ ? forces_->variableCount() : 0; }
+  bool bilevel() const;
+  int forceVariableCount() const;
   int forceVariableStart() const { return forceStart_; }
   /// Bilevel: the inner problems of the last evaluation (all zero otherwise).
   struct InnerStatistics {
@@ -288,12 +288,7 @@ class MotionProblem final : public NlpProblem {
     std::vector<int> forceColumns; ///< global variable of each local force column
     /// The force terms behind the local force columns, in their order: the contact, the
     /// term's weight, its first local column (six each). Laid out once, with forceColumns.
-    struct ForceTerm {
-      int contact;
-      double weight;
-      int firstColumn;
-    };
-    std::vector<ForceTerm> forceTerms;
+    std::vector<LocalForceTerm> forceTerms;
     /// With closed chains: ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) at this instant (closed_chains.hpp),
     /// and the closing joints' angles reached last (the next Newton start; NaN: none yet).
     Eigen::MatrixXd closureMap;
@@ -448,14 +443,13 @@ class MotionProblem final : public NlpProblem {
   SampledTrajectory taskSamples_;         ///< the task instants, as normalised times
   int jointCount_ = 0, parameterCount_ = 0, variableCount_ = 0, slackStart_ = 0, forceStart_ = 0;
   SampleOutputs outputs_;
-  bool bilevel_ = false;
   std::vector<std::array<double, 2>> windows_;   ///< per environment contact, normalised
-  std::unique_ptr<ContactForceParametrization> forces_;
+  /// How the environment contacts' wrenches are chosen (contact_force_formulation.hpp).
+  std::unique_ptr<ContactForceFormulation> formulation_;
   std::unique_ptr<ClosedChains> closure_;  ///< null without environment contacts
   /// Per spline parameter: fixed and unused, every sample and task instant it reaches closing
   /// its joint (a whole-motion contact's closing joints: all theirs; a window's: those inside it).
   std::vector<bool> unusedParameter_;
-  std::vector<std::unique_ptr<BilevelSample>> bilevelSamples_;
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit (when limited)
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)

@@ -15,8 +15,8 @@
 #include "core/trajectory_evaluation.hpp"
 #include "outer_nlp/ball_flight_task.hpp"
 #include "outer_nlp/ballistic_flight.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
@@ -95,8 +95,8 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
       if (F[2] > 0.0) p.centerOfPressure[c].col(s) = Eigen::Vector2d(-F[4] / F[2], F[3] / F[2]);
       p.frictionMargin[c][s] = surfaces[c]->friction * F[2] - F.head<2>().norm();
     }
-    if (bilevel_) {
-      const InnerStatus status = bilevelSamples_[static_cast<std::size_t>(s)]->innerResult().status;
+    if (const InnerResult* inner = formulation_->innerResult(s)) {
+      const InnerStatus status = inner->status;
       p.innerStatus.push_back(toString(status));
       p.infeasibleSamples += status == InnerStatus::Infeasible;
       p.failedSamples += status == InnerStatus::Failed;

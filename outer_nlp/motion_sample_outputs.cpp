@@ -14,8 +14,8 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
-#include "sensitivity/bilevel_sample.hpp"
 
 namespace mcopt {
 
@@ -37,97 +37,19 @@ void MotionProblem::evaluateSample(int s, const Eigen::VectorXd& x, double T, bo
 
 void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivatives, ThreadWorkspace& w,
                                   SampleBlock& b) {
-  const int n = jointCount_, contacts = outputs_.contacts;
+  const int n = jointCount_;
   const DynamicsModel& model = modelOf(s);  // with the ball before its release
   if (derivatives)
     inverseDynamicsDerivatives(model, w.data, w.derivatives, w.q, w.v, w.a);
   else
     inverseDynamics(model, w.data, w.q, w.v, w.a);
-  const DynamicsDerivatives& d = w.derivatives;
   b.velocity = w.v;
   b.acceleration = w.a;
   b.wrenches.setZero();
-
-  if (bilevel_) {
-    // The inner problem picks the wrenches (formulation.md §7); Γ and its derivatives
-    // through the KKT sensitivity (§8).
-    BilevelSample& sample = *bilevelSamples_[static_cast<std::size_t>(s)];
-    sample.evaluate(model, w.data, derivatives ? &d : nullptr, scenario_.actuators, w.v, w.a, derivatives);
-    w.torque = sample.torque();
-    b.y[outputs_.infeasibility()] = sample.infeasibility();
-    const Eigen::VectorXd& F = sample.innerResult().wrenches;
-    const ContactProblem& inner = sample.problem().problem;
-    b.wrenches.head<6>() = inner.contactWrench(F, 0);
-    for (int i = 0, k = 1; i < contacts; ++i)
-      if (contactActive(i, s)) b.wrenches.segment<6>(6 * (1 + i)) = inner.contactWrench(F, k++);
-    if (derivatives) {
-      b.dyDq.topRows(n) = sample.torqueDq();
-      b.dyDv.topRows(n) = sample.torqueDv();
-      b.dyDa.topRows(n) = sample.torqueDa();
-      b.dyDq.row(outputs_.infeasibility()) = sample.infeasibilityDq();
-      b.dyDv.row(outputs_.infeasibility()) = sample.infeasibilityDv();
-      b.dyDa.row(outputs_.infeasibility()) = sample.infeasibilityDa();
-    }
-  } else {
-    // Γ = Γ0 − Σ J1_i F_i and W_ref = W0 − Σ wrenchToWorld_i F_i over the environment
-    // contacts in contact here (formulation.md §5, §9); the reference contact takes W_ref.
-    w.torque = w.data.tau;
-    Vector6 reference = w.data.referenceWrench;
-    if (derivatives) w.torqueDq = d.dtauDq, w.referenceDq = d.dwrenchDq;
-    // A contact's rows depend on its own columns only: the others' entries must read zero
-    // even in a block that served another sample (the Hessian's probes).
-    if (derivatives) b.dyDz.setZero();
-    for (int i = 0; i < contacts; ++i) {
-      if (!forces_->active(i, s)) continue;
-      Vector6 F = Vector6::Zero();
-      for (const ContactForceParametrization::Term& t : forces_->terms(i, s)) F += t.weight * x.segment<6>(t.variable);
-      b.wrenches.segment<6>(6 * (1 + i)) = F;
-      const EnvironmentContact& contact = scenario_.contacts[static_cast<std::size_t>(i)];
-      const ContactFrame frame = contactFrame(model, w.data, contact.surface.frame, contact.surface.placement);
-      WrenchToTorque& toTorque = w.toTorque[static_cast<std::size_t>(i)];
-      Matrix6& toWorld = w.toWorld[static_cast<std::size_t>(i)];
-      wrenchToTorque(model, w.data, frame, toTorque);
-      wrenchToWorld(frame, toWorld);
-      w.torque.noalias() -= toTorque * F;
-      reference.noalias() -= toWorld * F;
-      contactRows_[static_cast<std::size_t>(i)].evaluate(F, b.y.segment(outputs_.contactRow(i, 0), outputs_.contactRowCount(1 + i)),
-                                                        w.rowsByWrench[static_cast<std::size_t>(i)]);
-      if (derivatives) {
-        wrenchMapDerivatives(model, w.data, frame, F, w.dWorld, w.dTorque);
-        w.torqueDq -= w.dTorque;
-        w.referenceDq -= w.dWorld;
-      }
-    }
-    const int perContact = support_.rowCount();
-    ContactRowsByWrench& rowsByReference = w.rowsByReference;
-    if (derivatives)
-      support_.evaluate(reference, b.y.segment(outputs_.referenceRow(0), perContact), rowsByReference);
-    else
-      support_.evaluate(reference, b.y.segment(outputs_.referenceRow(0), perContact));
-    b.wrenches.head<6>() = support_.contactWrench(reference);
-    if (derivatives) {
-      b.dyDq.topRows(n) = w.torqueDq;
-      b.dyDv.topRows(n) = d.dtauDv;
-      b.dyDa.topRows(n) = d.dtauDa;
-      // Small products of run-time sizes: coefficient-based (lazyProduct), as Eigen's blocked
-      // product may take heap workspace for them.
-      b.dyDq.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(w.referenceDq);
-      b.dyDv.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(d.dwrenchDv);
-      b.dyDa.middleRows(outputs_.referenceRow(0), perContact).noalias() = rowsByReference.lazyProduct(d.dwrenchDa);
-      // Force columns: ∂Γ/∂F_i = −J1_i, ∂rows_ref/∂F_i = −(∂rows/∂W_ref) wrenchToWorld_i,
-      // ∂rows_i/∂F_i, each times the term's weight.
-      // (`b` may be a Hessian probe: the sample's own block holds the column layout.)
-      for (const SampleBlock::ForceTerm& t : blocks_[static_cast<std::size_t>(s)].forceTerms) {
-        const auto i_ = static_cast<std::size_t>(t.contact);
-        const int column = t.firstColumn;
-        b.dyDz.block(outputs_.torque(0), column, n, 6) = -t.weight * w.toTorque[i_];
-        b.dyDz.block(outputs_.referenceRow(0), column, perContact, 6).noalias() =
-            -t.weight * rowsByReference.lazyProduct(w.toWorld[i_]);
-        b.dyDz.block(outputs_.contactRow(t.contact, 0), column, outputs_.contactRowCount(1 + t.contact), 6) =
-            t.weight * w.rowsByWrench[i_];
-      }
-    }
-  }
+  // Γ, the contact wrenches and the formulation's rows (contact_force_formulation.hpp).
+  FormulationSample sample{s, model, w, x, derivatives, blocks_[static_cast<std::size_t>(s)].forceTerms,
+                           b.y, b.wrenches, b.dyDq, b.dyDv, b.dyDa, b.dyDz};
+  formulation_->sampleOutputs(sample);
 
   for (int j = 0; j < n; ++j) {
     const MotorPowerDerivatives p = motorPowerDerivatives(scenario_.actuators.joints[static_cast<std::size_t>(j)],

@@ -14,6 +14,7 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/trajectory_evaluation.hpp"
+#include "outer_nlp/contact_force_formulation.hpp"
 #include "outer_nlp/motion_workspace.hpp"
 
 namespace mcopt {
@@ -44,7 +45,7 @@ void MotionProblem::buildStructure() {
     ClosureSet closed() const override { return b_->closed; }
     int forceColumnCount(int contact) const override {
       int count = 0;
-      for (const SampleBlock::ForceTerm& t : b_->forceTerms) count += t.contact == contact ? 6 : 0;
+      for (const LocalForceTerm& t : b_->forceTerms) count += t.contact == contact ? 6 : 0;
       return count;
     }
     int slackColumn(int joint) const override { return p_.slackIndex(block_, joint); }
@@ -62,7 +63,7 @@ void MotionProblem::buildStructure() {
     }
     void contactRow(int detail, int output, int contact) override {
       p_.rows_.push_back({term_, detail, block_, output, -1, place_, sign_});
-      for (const SampleBlock::ForceTerm& t : b_->forceTerms)
+      for (const LocalForceTerm& t : b_->forceTerms)
         for (int l = t.firstColumn; t.contact == contact && l < t.firstColumn + 6; ++l)
           entry(b_->forceColumns[static_cast<std::size_t>(l)], {Source::Force, task_, block_, output, l, sign_});
     }
@@ -162,16 +163,7 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
     for (int l = 0; l < m; ++l)
       if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) lower[j * m + l] = upper[j * m + l] = scenario_.start[j];
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
-  // A contact whose model holds a force alone (the point contact): its moment variables are
-  // fixed at zero.
-  for (int i = 0; forces_ && i < forces_->contactCount(); ++i) {
-    const int size = contactModelOf(contactSpec(scenario_.contacts[static_cast<std::size_t>(i)].surface), scenario_.inner.problem)
-                         .wrenchSize();
-    if (size == 6) continue;
-    for (int s = 0; s < samples_.sampleCount(); ++s)
-      for (const ContactForceParametrization::Term& t : forces_->terms(i, s))
-        lower.segment(t.variable + size, 6 - size).setZero(), upper.segment(t.variable + size, 6 - size).setZero();
-  }
+  formulation_->variableBounds(lower, upper);
   lower.tail(variableCount_ - slackStart_).setZero();
 }
 
