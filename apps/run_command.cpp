@@ -24,7 +24,7 @@
 #include "apps/result_motion.hpp"
 #include "apps/run_output.hpp"
 #include "inner_qp/inner_solver.hpp"
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
 #include "outer_nlp/scenario_run.hpp"

@@ -9,7 +9,7 @@
 
 #include <chrono>
 
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 
 namespace mcopt::bench {
@@ -25,16 +25,16 @@ void optimisation(benchmark::State& state, const std::string& file, ContactForce
   SolverOption limit;
   limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = kIterations;
   scenario.solverOptions.push_back(limit);
-  IpoptSettings settings;
+  OuterSolverSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
-  IpoptOutcome outcome;
+  OuterOutcome outcome;
   double violation = 0.0, seconds = 0.0;
   for (auto _ : state) {
     const auto clock = std::chrono::steady_clock::now();
     MotionProblem problem(scenario);
     const Eigen::VectorXd x0 = problem.initialPoint(scenario.start, scenario.end);
-    outcome = solveWithIpopt(problem, x0, settings, nullptr);
+    outcome = solveOuter(problem, x0, settings, nullptr);
     seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
     state.SetIterationTime(seconds);
     violation = outcome.x.size() == x0.size() ? problem.violations(outcome.x).overall : -1.0;

@@ -11,6 +11,7 @@
 
 #include <chrono>
 #include <iterator>
+#include <sstream>
 
 #include "core/errors.hpp"
 
@@ -21,32 +22,27 @@ namespace {
 using Ipopt::Index;
 using Ipopt::Number;
 
-/// Each OuterStatus's name in result.json and Ipopt's words for it, in the enum's order:
-/// the one place the statuses are listed.
-struct StatusText {
-  const char* name;
-  const char* message;
+/// Ipopt's words for each OuterStatus, in the enum's order.
+constexpr const char* kIpoptMessages[] = {
+    "Ipopt was running",
+    "Optimal Solution Found",
+    "Solved To Acceptable Level",
+    "Maximum Number of Iterations Exceeded",
+    "Maximum CPU time exceeded",
+    "Search Direction is becoming Too Small",
+    "Converged to a point of local infeasibility",
+    "Stopping optimization at current point as requested by user",
+    "Feasible point for square problem found",
+    "Iterates diverging; problem might be unbounded",
+    "Restoration Phase Failed",
+    "Error in step computation",
+    "Invalid number in NLP function or derivative detected",
+    "Problem has too few degrees of freedom",
+    "Invalid option",
+    "Not enough memory",
+    "Internal error",
 };
-constexpr StatusText kStatusText[] = {
-    {"running", "Ipopt was running"},
-    {"optimal", "Optimal Solution Found"},
-    {"acceptable", "Solved To Acceptable Level"},
-    {"maximum_iterations", "Maximum Number of Iterations Exceeded"},
-    {"maximum_cpu_time", "Maximum CPU time exceeded"},
-    {"tiny_step", "Search Direction is becoming Too Small"},
-    {"infeasible", "Converged to a point of local infeasibility"},
-    {"interrupted", "Stopping optimization at current point as requested by user"},
-    {"feasible_point_found", "Feasible point for square problem found"},
-    {"diverging", "Iterates diverging; problem might be unbounded"},
-    {"restoration_failed", "Restoration Phase Failed"},
-    {"error_in_step_computation", "Error in step computation"},
-    {"invalid_number", "Invalid number in NLP function or derivative detected"},
-    {"too_few_degrees_of_freedom", "Problem has too few degrees of freedom"},
-    {"invalid_option", "Invalid option"},
-    {"out_of_memory", "Not enough memory"},
-    {"internal_error", "Internal error"},
-};
-static_assert(std::size(kStatusText) == static_cast<std::size_t>(OuterStatus::InternalError) + 1);
+static_assert(std::size(kIpoptMessages) == static_cast<std::size_t>(OuterStatus::InternalError) + 1);
 
 OuterStatus fromIpopt(Ipopt::SolverReturn status) {
   switch (status) {
@@ -84,7 +80,7 @@ class Clock {
 
 class ProblemTnlp final : public Ipopt::TNLP {
  public:
-  ProblemTnlp(NlpProblem& problem, const Eigen::VectorXd& start, IpoptOutcome& outcome,
+  ProblemTnlp(NlpProblem& problem, const Eigen::VectorXd& start, OuterOutcome& outcome,
               const std::function<bool(const IterationReport&)>& onIteration, bool hessian)
       : problem_(problem), start_(start), outcome_(outcome), onIteration_(onIteration),
         clock_(std::chrono::steady_clock::now()), hessian_(hessian) {
@@ -189,7 +185,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
                          const Number*, const Number*, Number objective, const Ipopt::IpoptData*,
                          Ipopt::IpoptCalculatedQuantities*) override {
     outcome_.status = fromIpopt(status);
-    outcome_.message = kStatusText[static_cast<std::size_t>(outcome_.status)].message;
+    outcome_.message = kIpoptMessages[static_cast<std::size_t>(outcome_.status)];
     finalized_ = true;
     outcome_.objective = objective;
     if (x != nullptr) outcome_.x = copy(x, n);
@@ -224,7 +220,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
 
   NlpProblem& problem_;
   Eigen::VectorXd start_, xLower_, xUpper_, gLower_, gUpper_, buffer_;
-  IpoptOutcome& outcome_;
+  OuterOutcome& outcome_;
   const std::function<bool(const IterationReport&)>& onIteration_;
   std::chrono::steady_clock::time_point clock_;
   bool hessian_;
@@ -247,47 +243,78 @@ void apply(Ipopt::IpoptApplication& app, const SolverOption& o) {
                      " (unknown option, wrong type or out of range; see Ipopt's option list)");
 }
 
+/// An option of ours, in Ipopt's terms (`origin` for the message should Ipopt reject it).
+SolverOption ours(const std::string& name, double value, const std::string& origin) {
+  SolverOption o;
+  o.name = name, o.type = SolverOption::Type::Number, o.number = value, o.origin = origin;
+  std::ostringstream text;
+  text << value;
+  o.text = text.str();
+  return o;
+}
+
+class IpoptSolver final : public OuterSolver {
+ public:
+  std::string_view name() const override { return "ipopt"; }
+
+  OuterOutcome solve(NlpProblem& problem, const Eigen::VectorXd& start, const OuterSolverSettings& settings,
+                     const IterationCallback& onIteration) const override {
+    Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
+    app->RethrowNonIpoptException(false);
+    // Ours first (formulation.md §10); the scenario's options override them.
+    app->Options()->SetIntegerValue("print_level", settings.printLevel);
+    app->Options()->SetStringValue("sb", "yes");
+    app->Options()->SetStringValue("hessian_approximation", settings.problemHessian ? "exact" : "limited-memory");
+    app->Options()->SetNumericValue("tol", 1e-6);
+    app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
+    app->Options()->SetIntegerValue("max_iter", 3000);
+    // MUMPS's maximum-transversal permutation made each factorisation of the motion problem's
+    // KKT system 5× slower (0.5 s against 0.1 s an iteration, HRP-2 kick; docs/reference/scenario-file.md).
+    app->Options()->SetIntegerValue("mumps_permuting_scaling", 0);
+    // MUMPS's automatic choice of ordering was not the same from one run to the next on the
+    // epigraph form's KKT system: the offset-free kick's epigraph stage took 3 s in some runs and
+    // 74-107 s in others (its dense fronts factorised pivot by pivot), with results that differed
+    // in their last bits. AMF, the one it chose on the smooth kick, gives the same iterate and
+    // time every run (docs/reference/scenario-file.md, "Ipopt options we set").
+    app->Options()->SetIntegerValue("mumps_pivot_order", 2);
+    if (settings.tolerance) apply(*app, ours("tol", *settings.tolerance, "mcopt: "));
+    if (settings.constraintTolerance) apply(*app, ours("constr_viol_tol", *settings.constraintTolerance, "mcopt: "));
+    // A start to keep: Ipopt's default pushes of 1e-2 off the bounds (of variables and of
+    // inequality rows) would move it off its own point, and a small barrier parameter keeps
+    // Ipopt near it instead of re-centring it (docs/theory/outer-problem.md, "Continuation").
+    if (settings.warmStart) {
+      for (const char* push : {"bound_push", "bound_frac", "slack_bound_push", "slack_bound_frac"})
+        apply(*app, ours(push, 1e-9, settings.warmStart->origin));
+      apply(*app, ours("mu_init", settings.warmStart->barrier, settings.warmStart->origin));
+    }
+    for (const SolverOption& o : settings.options) apply(*app, o);
+    if (settings.maxIterations) {
+      SolverOption limit;
+      limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = *settings.maxIterations;
+      limit.text = std::to_string(limit.integer), limit.origin = "mcopt: ";
+      apply(*app, limit);
+    }
+    if (app->Initialize() != Ipopt::Solve_Succeeded) throw InputError("Ipopt could not be initialised");
+
+    OuterOutcome outcome;
+    const auto clock = std::chrono::steady_clock::now();
+    auto* adapter = new ProblemTnlp(problem, start, outcome, onIteration, settings.problemHessian);
+    Ipopt::SmartPtr<Ipopt::TNLP> tnlp = adapter;  // owns it
+    const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
+    outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
+    outcome.timings.total = outcome.seconds;
+    const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
+    if (Ipopt::IsValid(statistics)) outcome.iterations = statistics->IterationCount();
+    if (!adapter->finalized()) {
+      outcome.status = status == Ipopt::Invalid_Option ? OuterStatus::InvalidOption : OuterStatus::InternalError;
+      outcome.message = "Ipopt stopped before it had an iterate (return code " + std::to_string(static_cast<int>(status)) + ")";
+    }
+    return outcome;
+  }
+};
+
 }  // namespace
 
-const char* toString(OuterStatus status) { return kStatusText[static_cast<std::size_t>(status)].name; }
-
-IpoptOutcome solveWithIpopt(NlpProblem& problem, const Eigen::VectorXd& start, const IpoptSettings& settings,
-                            const std::function<bool(const IterationReport&)>& onIteration) {
-  Ipopt::SmartPtr<Ipopt::IpoptApplication> app = IpoptApplicationFactory();
-  app->RethrowNonIpoptException(false);
-  // Ours first (formulation.md §10); the scenario's options override them.
-  app->Options()->SetIntegerValue("print_level", settings.printLevel);
-  app->Options()->SetStringValue("sb", "yes");
-  app->Options()->SetStringValue("hessian_approximation", settings.problemHessian ? "exact" : "limited-memory");
-  app->Options()->SetNumericValue("tol", 1e-6);
-  app->Options()->SetNumericValue("constr_viol_tol", 1e-8);
-  app->Options()->SetIntegerValue("max_iter", 3000);
-  // MUMPS's maximum-transversal permutation made each factorisation of the motion problem's
-  // KKT system 5× slower (0.5 s against 0.1 s an iteration, HRP-2 kick; docs/reference/scenario-file.md).
-  app->Options()->SetIntegerValue("mumps_permuting_scaling", 0);
-  // MUMPS's automatic choice of ordering was not the same from one run to the next on the
-  // epigraph form's KKT system: the offset-free kick's epigraph stage took 3 s in some runs and
-  // 74-107 s in others (its dense fronts factorised pivot by pivot), with results that differed
-  // in their last bits. AMF, the one it chose on the smooth kick, gives the same iterate and
-  // time every run (docs/reference/scenario-file.md, "Ipopt options we set").
-  app->Options()->SetIntegerValue("mumps_pivot_order", 2);
-  for (const SolverOption& o : settings.options) apply(*app, o);
-  if (app->Initialize() != Ipopt::Solve_Succeeded) throw InputError("Ipopt could not be initialised");
-
-  IpoptOutcome outcome;
-  const auto clock = std::chrono::steady_clock::now();
-  auto* adapter = new ProblemTnlp(problem, start, outcome, onIteration, settings.problemHessian);
-  Ipopt::SmartPtr<Ipopt::TNLP> tnlp = adapter;  // owns it
-  const Ipopt::ApplicationReturnStatus status = app->OptimizeTNLP(tnlp);
-  outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock).count();
-  outcome.timings.total = outcome.seconds;
-  const Ipopt::SmartPtr<Ipopt::SolveStatistics> statistics = app->Statistics();
-  if (Ipopt::IsValid(statistics)) outcome.iterations = statistics->IterationCount();
-  if (!adapter->finalized()) {
-    outcome.status = status == Ipopt::Invalid_Option ? OuterStatus::InvalidOption : OuterStatus::InternalError;
-    outcome.message = "Ipopt stopped before it had an iterate (return code " + std::to_string(static_cast<int>(status)) + ")";
-  }
-  return outcome;
-}
+std::unique_ptr<OuterSolver> makeIpoptSolver() { return std::make_unique<IpoptSolver>(); }
 
 }  // namespace mcopt

@@ -9,7 +9,7 @@
 namespace mcopt {
 
 MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, const Eigen::VectorXd& x0,
-                               const IpoptSettings& settings, const MotionSolveEvents& events) {
+                               const OuterSolverSettings& settings, const MotionSolveEvents& events) {
   // Stages meant for another contact-force formulation are not run (and not counted).
   const Scenario scenario = withStagesForItsFormulation(given);
   MotionSolveOutcome result;
@@ -42,57 +42,44 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     stage.samples = stageScenario.samples;
     stage.hessian = stageScenario.hessian;
     stage.energyForm = stageScenario.energyForm;
-    IpoptOutcome outcome;
+    OuterOutcome outcome;
     int joined = 0;
     for (;;) {
       MotionProblem current(stageScenario, omitted);
       current.startClosureAt(closureAngles);  // the closure continues the motion's branch
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
       if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
-      IpoptSettings roundSettings = settings;
+      OuterSolverSettings roundSettings = settings;
       roundSettings.problemHessian = stageScenario.hessian != HessianOption::LimitedMemory;
-      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations >= 0) {
-        SolverOption limit;  // after the scenario's options: the stage's own limit wins
-        limit.name = "max_iter", limit.type = SolverOption::Type::Integer;
-        limit.integer = scenario.continuation[static_cast<std::size_t>(k)].maxIterations;
-        limit.text = std::to_string(limit.integer), limit.origin = "continuation stage: ";
-        roundSettings.options.push_back(limit);
-      }
-      // A later stage, and a screening round, starts at the iterate the last solve ended on: a
-      // small barrier parameter keeps Ipopt near it instead of re-centring it (measured on the
-      // bilevel weight shift: from the Gauss–Newton stage's iterate, sample-differences ended
-      // optimal after 79 iterations with it, and not in 1000 without it; docs/reference/scenario-file.md).
-      // So does the first solve from a given motion (--start-from: another run's optimum).
-      // The epigraph form starts lower still: its slacks start at max(P, 0), on their bounds,
-      // and a barrier μ lifts each by about 2μ/c (c the sample's weight in the criterion, the
-      // smooth maximum's offset with ε = 2μ/c): at 1e-4 the kick's 3000 slacks rose to a
-      // criterion of 0.6 J before coming back, 161 iterations with the exact Hessian and none
-      // in 400 with gauss-newton; at 1e-6, 47 and 55 to the same optimum (docs/reference/scenario-file.md,
-      // "Continuation"). Ours first: the scenario's `solver` options still override it.
+      // After the scenario's options: the stage's own limit wins.
+      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations >= 0)
+        roundSettings.maxIterations = scenario.continuation[static_cast<std::size_t>(k)].maxIterations;
+      // A later stage, and a screening round, starts at the iterate the last solve ended on, to
+      // be kept: a small barrier parameter keeps Ipopt near it instead of re-centring it
+      // (measured on the bilevel weight shift: from the Gauss–Newton stage's iterate,
+      // sample-differences ended optimal after 79 iterations with it, and not in 1000 without
+      // it; docs/reference/scenario-file.md). So does the first solve from a given motion
+      // (--start-from: another run's optimum). The epigraph form starts lower still: its slacks
+      // start at max(P, 0), on their bounds, and a barrier μ lifts each by about 2μ/c (c the
+      // sample's weight in the criterion, the smooth maximum's offset with ε = 2μ/c): at 1e-4
+      // the kick's 3000 slacks rose to a criterion of 0.6 J before coming back, 161 iterations
+      // with the exact Hessian and none in 400 with gauss-newton; at 1e-6, 47 and 55 to the
+      // same optimum (docs/reference/scenario-file.md, "Continuation"). The scenario's `solver`
+      // options still override it.
+      // Such a start is not pushed off its bounds either (the solver's default pushes would
+      // move a feasible start off its own point — the bilevel optimum that --start-from gives
+      // another formulation, formulation.md §9, or a smooth-maximum stage's optimum with the
+      // epigraph's slacks at max(P, 0), many at 0): measured, the second stage after 500
+      // Gauss–Newton iterations then took 59 instead of 86 iterations on the weight shift, 49
+      // instead of 63 on the one-foot throw, 48 instead of 59 on the kick without configuration
+      // optimisation (docs/reference/scenario-file.md).
       if (k > 0 || stage.rounds > 0 || scenario.initialMotion) {
         const bool epigraph = stageScenario.energyForm == EnergyForm::Epigraph;
-        SolverOption barrier;
-        barrier.name = "mu_init", barrier.type = SolverOption::Type::Number, barrier.number = epigraph ? 1e-6 : 1e-4;
-        barrier.text = epigraph ? "1e-6" : "1e-4";
-        barrier.origin = stage.rounds > 0 ? "torque-limit screening: " : k > 0 ? "continuation stage: " : "--start-from: ";
-        roundSettings.options.insert(roundSettings.options.begin(), barrier);
+        roundSettings.warmStart = OuterSolverSettings::WarmStart{
+            epigraph ? 1e-6 : 1e-4,
+            stage.rounds > 0 ? "torque-limit screening: " : k > 0 ? "continuation stage: " : "--start-from: "};
       }
-      // A given motion is taken as it is: Ipopt's default pushes of 1e-2 off the bounds (of
-      // variables and of inequality rows) would move a feasible start off its own point — the
-      // bilevel optimum that --start-from gives another formulation (formulation.md §9), or a
-      // smooth-maximum stage's optimum with the epigraph's slacks at max(P, 0), many at 0.
-      // So is every later stage's and screening round's start, the iterate the last solve ended
-      // on: measured, the second stage after 500 Gauss–Newton iterations then took 59 instead
-      // of 86 iterations on the weight shift, 49 instead of 63 on the one-foot throw, 48
-      // instead of 59 on the kick without configuration optimisation (docs/reference/scenario-file.md).
-      if (k > 0 || stage.rounds > 0 || scenario.initialMotion.has_value())
-        for (const char* push : {"bound_push", "bound_frac", "slack_bound_push", "slack_bound_frac"}) {
-          SolverOption o;
-          o.name = push, o.type = SolverOption::Type::Number, o.number = 1e-9, o.text = "1e-9";
-          o.origin = stage.rounds > 0 ? "torque-limit screening: " : k > 0 ? "continuation stage: " : "--start-from: ";
-          roundSettings.options.insert(roundSettings.options.begin(), o);
-        }
-      outcome = solveWithIpopt(current, x, roundSettings, [&](const IterationReport& r) {
+      outcome = solveOuter(current, x, roundSettings, [&](const IterationReport& r) {
         return !events.onIteration || events.onIteration(k, current, r);
       });
       closureAngles = current.closureAngles();

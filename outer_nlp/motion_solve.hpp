@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/scenario.hpp"
 
@@ -46,7 +46,7 @@ struct MotionSolveEvents {
 };
 
 struct MotionSolveOutcome {
-  IpoptOutcome solver;              ///< the last solve's, with x the last usable iterate
+  OuterOutcome solver;              ///< the last solve's, with x the last usable iterate
   std::vector<StageOutcome> stages;
   std::string reason;               ///< why the solve ended before the scenario's own problem, if it did
 };
@@ -54,6 +54,6 @@ struct MotionSolveOutcome {
 /// `problem` is the scenario's own (full) motion problem; x0 its starting point. Continuation
 /// stages for other contact-force formulations than the scenario's are left out.
 MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,
-                               const IpoptSettings& settings, const MotionSolveEvents& events);
+                               const OuterSolverSettings& settings, const MotionSolveEvents& events);
 
 }  // namespace mcopt

@@ -33,12 +33,9 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
   ConfigurationProblem problem(scenario, motion.model(), motion.support(), instant, std::move(near));
   outcome.optimised = true;
   outcome.staticPowerBefore = problem.staticPower(guess);
-  IpoptSettings settings;
-  SolverOption iterations;
-  iterations.name = "max_iter", iterations.type = SolverOption::Type::Integer;
-  iterations.integer = scenario.configurationIterations, iterations.origin = "initialisation.configuration_iterations: ";
-  settings.options = {iterations};
-  const IpoptOutcome result = solveWithIpopt(problem, guess, settings, [&](const IterationReport&) {
+  OuterSolverSettings settings;
+  settings.maxIterations = scenario.configurationIterations;  // initialisation.configuration_iterations
+  const OuterOutcome result = solveOuter(problem, guess, settings, [&](const IterationReport&) {
     return !events.keepRunning || events.keepRunning();
   });
   outcome.status = result.status;
@@ -218,7 +215,7 @@ void solveScenarioFrom(const Scenario& scenario, MotionProblem& problem, const E
                        const ScenarioRunEvents& events, RunRecord& record) {
   const auto clock = std::chrono::steady_clock::now();
   const double before = record.totalSeconds;  // what the record already holds (a refinement's earlier rounds)
-  IpoptSettings settings;
+  OuterSolverSettings settings;
   settings.options = scenario.solverOptions;
   settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
   const auto optimisationClock = std::chrono::steady_clock::now();

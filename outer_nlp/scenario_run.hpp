@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/motion_solve.hpp"
 #include "outer_nlp/motion_verification.hpp"
@@ -99,7 +99,7 @@ struct RunRecord {
     double distance = 0.0;     ///< ‖q − path‖ [rad]
   };
   std::vector<ContactPosture> contactPostures;
-  IpoptOutcome solver;
+  OuterOutcome solver;
   std::vector<IterationRecord> history;
   std::vector<StageOutcome> stages;  ///< one per continuation stage, the scenario's own problem last
   double configurationSeconds = 0.0, optimisationSeconds = 0.0, totalSeconds = 0.0;

@@ -191,12 +191,12 @@ StandingPosture findStandingPosture(const RobotModel& robot, const ContactSurfac
     const double margin = std::min(0.2, 0.25 * (upper[j] - lower[j]));
     start[j] = std::clamp(start[j], lower[j] + margin, upper[j] - margin);
   }
-  IpoptSettings ipopt;
-  ipopt.problemHessian = true;
-  ipopt.options = {{SolverOption::Type::Integer, "max_iter", "", "robot init", 0.0, settings.maxIterations},
-                   {SolverOption::Type::Number, "tol", "", "robot init", 1e-8, 0},
-                   {SolverOption::Type::Number, "constr_viol_tol", "", "robot init", settings.tolerance, 0}};
-  const IpoptOutcome outcome = solveWithIpopt(problem, start, ipopt, [](const IterationReport&) { return true; });
+  OuterSolverSettings solver;
+  solver.problemHessian = true;
+  solver.maxIterations = settings.maxIterations;
+  solver.tolerance = 1e-8;
+  solver.constraintTolerance = settings.tolerance;
+  const OuterOutcome outcome = solveOuter(problem, start, solver, [](const IterationReport&) { return true; });
 
   StandingPosture result;
   result.status = outcome.status;

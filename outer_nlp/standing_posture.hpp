@@ -18,7 +18,7 @@
 
 #include "core/robot_files.hpp"
 #include "core/robot_model.hpp"
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 
 namespace mcopt {
 

@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-// The Ipopt driver on problems with known solutions: both Hessian modes reach them, the
-// finite-difference Hessian in Newton-like iteration counts, a stop request is honoured and
-// bad options are refused with the scenario's line.
+// The outer solver interface and Ipopt behind it, on problems with known solutions: both
+// Hessian modes reach them, the finite-difference Hessian in Newton-like iteration counts, a
+// stop request is honoured, bad options are refused with the scenario's line, the settings in
+// the interface's own terms (iteration limit, tolerances, a start to keep) act, and the
+// registry names its solvers.
 #include <catch2/catch.hpp>
 
 #include <fstream>
@@ -90,11 +92,11 @@ class FixedThenDiscRosenbrock final : public NlpProblem {
 TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", "[outer]") {
   DiscRosenbrock problem;
   const Eigen::VectorXd start = (Eigen::VectorXd(2) << -0.5, 0.2).finished();
-  IpoptSettings limitedMemory, differences;
+  OuterSolverSettings limitedMemory, differences;
   differences.problemHessian = true;
-  const IpoptOutcome quasiNewton = solveWithIpopt(problem, start, limitedMemory, nullptr);
-  const IpoptOutcome newton = solveWithIpopt(problem, start, differences, nullptr);
-  for (const IpoptOutcome* o : {&quasiNewton, &newton}) {
+  const OuterOutcome quasiNewton = solveOuter(problem, start, limitedMemory, nullptr);
+  const OuterOutcome newton = solveOuter(problem, start, differences, nullptr);
+  for (const OuterOutcome* o : {&quasiNewton, &newton}) {
     CHECK(o->status == OuterStatus::Optimal);
     CHECK(o->optimal());
     CHECK(o->x[0] == Approx(0.786415).margin(1e-5));
@@ -107,7 +109,7 @@ TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", 
 TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-difference Hessian", "[outer]") {
   DiscRosenbrock problem;
   const test::TempDir dir;
-  IpoptSettings settings;
+  OuterSolverSettings settings;
   settings.problemHessian = true;
   auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
     SolverOption o;
@@ -121,7 +123,7 @@ TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-differe
                       option("max_iter", "0", SolverOption::Type::Integer),
                       option("output_file", log.string(), SolverOption::Type::Text),
                       option("file_print_level", "5", SolverOption::Type::Integer)};
-  solveWithIpopt(problem, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), settings, nullptr);
+  solveOuter(problem, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), settings, nullptr);
   std::ifstream in(log);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK_THAT(text, Catch::Contains("Starting derivative checker for second derivatives"));
@@ -132,7 +134,7 @@ TEST_CASE("Ipopt driver: a stop request ends the solve as interrupted with its i
   DiscRosenbrock problem;
   const Eigen::VectorXd start = (Eigen::VectorXd(2) << -0.5, 0.2).finished();
   int seen = 0;
-  const IpoptOutcome o = solveWithIpopt(problem, start, IpoptSettings{}, [&](const IterationReport& r) {
+  const OuterOutcome o = solveOuter(problem, start, OuterSolverSettings{}, [&](const IterationReport& r) {
     seen = r.iteration;
     return r.iteration < 3;
   });
@@ -147,11 +149,11 @@ TEST_CASE("Ipopt driver: every iteration reports its iterate in the problem's va
   FixedThenDiscRosenbrock problem;
   const Eigen::VectorXd start = (Eigen::VectorXd(3) << 0.25, -0.5, 0.2).finished();
   for (const bool newton : {false, true}) {
-    IpoptSettings settings;
+    OuterSolverSettings settings;
     settings.problemHessian = newton;
     int reported = 0;
     Eigen::VectorXd last;
-    const IpoptOutcome o = solveWithIpopt(problem, start, settings, [&](const IterationReport& r) {
+    const OuterOutcome o = solveOuter(problem, start, settings, [&](const IterationReport& r) {
       if (r.iterate == nullptr) return true;  // restoration phase
       ++reported;
       REQUIRE(r.iterate->size() == 3);
@@ -169,13 +171,78 @@ TEST_CASE("Ipopt driver: every iteration reports its iterate in the problem's va
 
 TEST_CASE("Ipopt driver: options Ipopt refuses are input errors naming their origin", "[outer]") {
   DiscRosenbrock problem;
-  IpoptSettings settings;
+  OuterSolverSettings settings;
   SolverOption bad;
   bad.name = "no_such_option", bad.type = SolverOption::Type::Integer, bad.integer = 3;
   bad.origin = "s.yaml:12: solver.no_such_option: ";
   settings.options = {bad};
-  CHECK_THROWS_WITH(solveWithIpopt(problem, Eigen::VectorXd::Zero(2), settings, nullptr),
+  CHECK_THROWS_WITH(solveOuter(problem, Eigen::VectorXd::Zero(2), settings, nullptr),
                     Catch::Contains("s.yaml:12: solver.no_such_option: Ipopt rejects option"));
+}
+
+TEST_CASE("outer solver: the registry lists ipopt and refuses an unknown name with the list", "[outer]") {
+  CHECK(outerSolverNames() == std::vector<std::string>{"ipopt"});
+  CHECK(makeOuterSolver("ipopt")->name() == "ipopt");
+  CHECK_THROWS_WITH(makeOuterSolver("snopt"), Catch::Contains("expected ipopt; got 'snopt'"));
+  OuterSolverSettings settings;
+  settings.solver = "snopt";
+  DiscRosenbrock problem;
+  CHECK_THROWS_AS(solveOuter(problem, Eigen::VectorXd::Zero(2), settings, nullptr), InputError);
+}
+
+TEST_CASE("outer solver: the iteration limit overrides the solver's own options", "[outer]") {
+  DiscRosenbrock problem;
+  const Eigen::VectorXd start = (Eigen::VectorXd(2) << -0.5, 0.2).finished();
+  OuterSolverSettings settings;
+  SolverOption many;
+  many.name = "max_iter", many.type = SolverOption::Type::Integer, many.integer = 100, many.text = "100";
+  settings.options = {many};
+  settings.maxIterations = 4;
+  const OuterOutcome o = solveOuter(problem, start, settings, nullptr);
+  CHECK(o.status == OuterStatus::MaximumIterations);
+  CHECK(o.iterations == 4);
+}
+
+TEST_CASE("outer solver: a start to keep is not pushed off its bounds", "[outer]") {
+  // min (x − 2)² + y² over x ∈ [0, 1], y ∈ [−1, 1], from x on its bound: the optimum is that
+  // start. Without a kept start Ipopt first pushes x inside (bound_push 1e-2), and the first
+  // iterate moves; kept, the first iterate is the start itself and the solve stays there.
+  class Boxed final : public NlpProblem {
+   public:
+    int variableCount() const override { return 2; }
+    int constraintCount() const override { return 0; }
+    const Eigen::VectorXi& jacobianRows() const override { return empty_; }
+    const Eigen::VectorXi& jacobianColumns() const override { return empty_; }
+    void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override {
+      lower = Eigen::Vector2d(0.0, -1.0), upper = Eigen::Vector2d(1.0, 1.0);
+    }
+    void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override { lower.resize(0), upper.resize(0); }
+    double objective(const Eigen::VectorXd& v) override { return (v[0] - 2) * (v[0] - 2) + v[1] * v[1]; }
+    void objectiveGradient(const Eigen::VectorXd& v, Eigen::VectorXd& g) override { g = Eigen::Vector2d(2 * (v[0] - 2), 2 * v[1]); }
+    void constraints(const Eigen::VectorXd&, Eigen::VectorXd& g) override { g.resize(0); }
+    void jacobianValues(const Eigen::VectorXd&, Eigen::VectorXd& values) override { values.resize(0); }
+    std::string rowName(int) const override { return ""; }
+
+   private:
+    Eigen::VectorXi empty_;
+  };
+  Boxed problem;
+  const Eigen::VectorXd start = Eigen::Vector2d(1.0, 0.0);
+  auto firstIterate = [&](const OuterSolverSettings& settings) {
+    Eigen::VectorXd first;
+    solveOuter(problem, start, settings, [&](const IterationReport& r) {
+      if (r.iteration == 0 && r.iterate != nullptr) first = *r.iterate;
+      return true;
+    });
+    return first;
+  };
+  OuterSolverSettings pushed, kept;
+  kept.warmStart = OuterSolverSettings::WarmStart{1e-9, "test: "};
+  const Eigen::VectorXd a = firstIterate(pushed), b = firstIterate(kept);
+  REQUIRE(a.size() == 2);
+  REQUIRE(b.size() == 2);
+  CHECK(1.0 - a[0] >= 1e-3);        // pushed inside by 1e-2 of the box
+  CHECK(1.0 - b[0] <= 1e-8);        // kept
 }
 
 }  // namespace mcopt
