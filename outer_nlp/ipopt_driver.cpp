@@ -1,5 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "outer_nlp/ipopt_driver.hpp"
+// Ipopt as the outer solver (outer_solver.hpp): exact first derivatives, the declared sparse
+// Jacobian, a limited-memory Hessian unless the settings say otherwise, the scenario's options
+// on top of ours (docs/reference/scenario-file.md, "Ipopt options we set"). Registered as
+// "ipopt" in outer_solver.cpp.
+#include "outer_nlp/outer_solver.hpp"
 
 #include <IpIpoptApplication.hpp>
 #include <IpIpoptCalculatedQuantities.hpp>

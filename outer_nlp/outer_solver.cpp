@@ -5,9 +5,10 @@
 #include <utility>
 
 #include "core/errors.hpp"
-#include "outer_nlp/ipopt_driver.hpp"
 
 namespace mcopt {
+
+std::unique_ptr<OuterSolver> makeIpoptSolver();  // ipopt_driver.cpp
 
 namespace {
 

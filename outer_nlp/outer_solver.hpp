@@ -5,8 +5,9 @@
 // that always carries the last iterate the solver handed back. The settings say what the
 // motion solve needs of any solver (an iteration limit, tolerances, a start to keep, the
 // problem's own Hessian) in its terms; a solver's own options (the scenario's `solver:`
-// mapping) pass through as they are. Ipopt (ipopt_driver.hpp) is the one registered; another
-// solver is a class deriving from OuterSolver and one line in outerSolvers() (outer_solver.cpp).
+// mapping) pass through as they are. Ipopt (ipopt_driver.cpp) is the one registered; another
+// solver is one file with a class deriving from OuterSolver and its factory, and one line in
+// outerSolvers() (outer_solver.cpp).
 
 #include <Eigen/Core>
 #include <functional>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: BSD-3-Clause
-#include "outer_nlp/scenario_yaml.hpp"
+#include "outer_nlp/scenario.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -12,6 +12,7 @@
 #include "core/spatial.hpp"
 #include "inner_qp/inner_solver.hpp"
 #include "core/yaml_fields.hpp"
+#include "outer_nlp/scenario_yaml.hpp"
 
 namespace mcopt {
 

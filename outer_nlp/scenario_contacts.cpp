@@ -9,6 +9,7 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "core/yaml_fields.hpp"
+#include "outer_nlp/scenario.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
 namespace mcopt {

@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
 #include "inner_qp/inner_solver.hpp"
+#include "outer_nlp/scenario.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
 namespace mcopt {

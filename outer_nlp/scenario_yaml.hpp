@@ -12,9 +12,12 @@
 #include <string>
 #include <vector>
 
-#include "outer_nlp/scenario.hpp"
+#include "core/robot_files.hpp"
 
 namespace mcopt {
+
+struct Scenario;             // outer_nlp/scenario.hpp
+enum class ContactForces;    // outer_nlp/scenario.hpp
 
 /// The `throw` task (formulation.md §10; docs/reference/scenario-file.md, "Throw"; outer_nlp/throw_task.cpp):
 /// `node` is tasks[i] with `kind: throw`; appends its two rows (BallFlightTask landing and

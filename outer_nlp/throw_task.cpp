@@ -9,6 +9,7 @@
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
 #include "outer_nlp/ball_flight_task.hpp"
+#include "outer_nlp/scenario.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
 namespace mcopt {

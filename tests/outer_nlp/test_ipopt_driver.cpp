@@ -11,7 +11,7 @@
 
 #include "common/temp_dir.hpp"
 #include "core/errors.hpp"
-#include "outer_nlp/ipopt_driver.hpp"
+#include "outer_nlp/outer_solver.hpp"
 
 namespace mcopt {
 
