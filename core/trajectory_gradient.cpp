@@ -4,7 +4,6 @@
 #include <omp.h>
 
 #include "core/no_malloc_scope.hpp"
-#include "core/sample_chunks.hpp"
 
 #include "core/errors.hpp"
 
@@ -20,8 +19,7 @@ TrajectoryGradientEvaluator::TrajectoryGradientEvaluator(const DynamicsModel& mo
   const int n = model.jointCount(), p = samples_.parametrization().parameterCount();
   for (ThreadWorkspace& w : workspaces_)
     for (Eigen::VectorXd* v : {&w.powerTorque, &w.rowQ, &w.rowV, &w.rowA}) v->setZero(n);
-  chunkSums_.resize(static_cast<std::size_t>(sampleChunkCount(samples_.sampleCount())));
-  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(p);
+  chunkSums_.reset(samples_.sampleCount(), p);
 }
 
 void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorXd>& parameters, double duration,
@@ -31,7 +29,7 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
   prepareTrajectoryResult(samples_, n, parameters, duration, r);
   g.torque.resize(static_cast<std::size_t>(count));
   parametrization.controlPoints(parameters, controlPoints_);
-  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(), sum.energyDT = 0.0;
+  chunkSums_.reset(count, parametrization.parameterCount());
   const double dt = duration / (count - 1);
 
   // Each sample's Jacobian block is sized by its first evaluation: checked once they all are.
@@ -41,7 +39,7 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
 #pragma omp parallel
   forEachSampleInChunks(count, [&](int s, int) {
     ThreadWorkspace& w = workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
-    ChunkSum& sum = chunkSums_[static_cast<std::size_t>(s / kSampleChunk)];
+    ChunkedEnergyGradient::Sum& sum = chunkSums_.of(s);
     r.time[s] = samples_.time(s, duration);
     samples_.evaluate(s, controlPoints_, duration, r.q.col(s), r.v.col(s), r.a.col(s));
     inverseDynamicsDerivatives(model_, w.data, w.derivatives, r.q.col(s), r.v.col(s), r.a.col(s));
@@ -85,12 +83,7 @@ void TrajectoryGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::VectorX
     sum.energyDT += sampleEnergy * weight / duration + directDT / duration + w.powerTorque.dot(block.dtauDT);
   });
   r.energy = positiveEnergy(r.power, r.time);
-  g.energyGradient.setZero(parametrization.parameterCount());
-  g.energyDT = 0.0;
-  for (const ChunkSum& sum : chunkSums_) {
-    g.energyGradient += sum.energyGradient;
-    g.energyDT += sum.energyDT;
-  }
+  chunkSums_.total(g.energyGradient, g.energyDT);
 }
 
 }  // namespace mcopt

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "core/dynamics_derivatives.hpp"
+#include "core/sample_chunks.hpp"
 #include "core/trajectory_evaluation.hpp"
 
 namespace mcopt {
@@ -30,6 +31,33 @@ struct TrajectoryGradient {
   Eigen::VectorXd energyGradient;           ///< ∂E/∂x, parameterCount
   double energyDT = 0.0;                    ///< ∂E/∂T
   std::vector<SampleTorqueJacobian> torque; ///< per sample
+};
+
+/// The energy's gradient summed per chunk of samples (core/sample_chunks.hpp), then over the
+/// chunks in order: the same sums in the same order for any thread count. The trajectory
+/// gradient and the multi-contact gradient (sensitivity/multi_contact_gradient.hpp) use it.
+class ChunkedEnergyGradient {
+ public:
+  struct Sum {
+    Eigen::VectorXd energyGradient;  ///< ∂E/∂x of the chunk's samples
+    double energyDT = 0.0;           ///< ∂E/∂T of the chunk's samples
+  };
+  /// Zeros every chunk's sum (sized on the first call; no allocation afterwards).
+  void reset(int sampleCount, int parameterCount) {
+    sums_.resize(static_cast<std::size_t>(sampleChunkCount(sampleCount)));
+    for (Sum& sum : sums_) sum.energyGradient.setZero(parameterCount), sum.energyDT = 0.0;
+  }
+  /// The sum sample s adds to (its chunk's).
+  Sum& of(int sample) { return sums_[static_cast<std::size_t>(sample / kSampleChunk)]; }
+  /// Σ over the chunks, in order, into gradient and dT (set, not added to).
+  void total(Eigen::VectorXd& gradient, double& dT) const {
+    gradient.setZero(sums_.empty() ? 0 : sums_.front().energyGradient.size());
+    dT = 0.0;
+    for (const Sum& sum : sums_) gradient += sum.energyGradient, dT += sum.energyDT;
+  }
+
+ private:
+  std::vector<Sum> sums_;
 };
 
 class TrajectoryGradientEvaluator {
@@ -47,18 +75,12 @@ class TrajectoryGradientEvaluator {
     DynamicsDerivatives derivatives;
     Eigen::VectorXd powerTorque, rowQ, rowV, rowA;
   };
-  /// A chunk's share of the energy's gradient (core/sample_chunks.hpp): summed over the chunks
-  /// in order, the same for any thread count.
-  struct ChunkSum {
-    Eigen::VectorXd energyGradient;
-    double energyDT = 0.0;
-  };
   const DynamicsModel& model_;
   ActuatorSet actuators_;
   SampledTrajectory samples_;
   Eigen::MatrixXd controlPoints_;
   std::vector<ThreadWorkspace> workspaces_;
-  std::vector<ChunkSum> chunkSums_;
+  ChunkedEnergyGradient chunkSums_;
 };
 
 }  // namespace mcopt

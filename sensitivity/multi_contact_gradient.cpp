@@ -123,7 +123,7 @@ void MultiContactGradientEvaluator::solveAllSamples() {
 }
 
 void MultiContactGradientEvaluator::finishSample(Workspace& w, int s, double duration, MultiContactResult& r,
-                                                 MultiContactGradient& grad, ChunkSum& sum) {
+                                                 MultiContactGradient& grad, ChunkedEnergyGradient::Sum& sum) {
   const int n = model_.jointCount();
   const int count = samples_.sampleCount(), m = samples_.parametrization().parametersPerJoint();
   TrajectoryResult& motion = r.motion;
@@ -190,8 +190,7 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
   grad.diagnostics.resize(static_cast<std::size_t>(count));
   samples_.parametrization().controlPoints(parameters, controlPoints_);
   for (auto& w : workspaces_) w->degenerate = w->withoutDerivative = 0;
-  chunkSums_.resize(static_cast<std::size_t>(sampleChunkCount(count)));
-  for (ChunkSum& sum : chunkSums_) sum.energyGradient.setZero(parameterCount), sum.energyDT = 0.0;
+  chunkSums_.reset(count, parameterCount);
   const int threads = static_cast<int>(workspaces_.size());
   // Once every sample's buffers are sized by a first evaluation, the per-sample path —
   // dynamics, inner solve, KKT assembly, factorisation and solve, chain rule — makes no Eigen
@@ -227,7 +226,7 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
     // in the same order for any thread count.
     Workspace& w = *workspaces_[static_cast<std::size_t>(omp_get_thread_num())];
     forEachSampleInChunks(count, [&](int s, int) {
-      finishSample(w, s, duration, r, grad, chunkSums_[static_cast<std::size_t>(s / kSampleChunk)]);
+      finishSample(w, s, duration, r, grad, chunkSums_.of(s));
     });
   }
   perSample.reset();
@@ -240,13 +239,8 @@ void MultiContactGradientEvaluator::evaluate(const Eigen::Ref<const Eigen::Vecto
     r.failedSamples += r.status[static_cast<std::size_t>(s)] == InnerStatus::Failed;
   }
   r.motion.energy = positiveEnergy(r.motion.power, r.motion.time);
-  grad.torqueAndEnergy.energyGradient.setZero(parameterCount);
-  grad.torqueAndEnergy.energyDT = 0.0;
   grad.degenerateSamples = grad.samplesWithoutDerivative = 0;
-  for (const ChunkSum& sum : chunkSums_) {
-    grad.torqueAndEnergy.energyGradient += sum.energyGradient;
-    grad.torqueAndEnergy.energyDT += sum.energyDT;
-  }
+  chunkSums_.total(grad.torqueAndEnergy.energyGradient, grad.torqueAndEnergy.energyDT);
   for (const auto& w : workspaces_) {
     grad.degenerateSamples += w->degenerate;
     grad.samplesWithoutDerivative += w->withoutDerivative;

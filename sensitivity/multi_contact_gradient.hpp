@@ -60,17 +60,12 @@ class MultiContactGradientEvaluator {
 
  private:
   struct Workspace;
-  /// A chunk's share of the energy's gradient (core/sample_chunks.hpp).
-  struct ChunkSum {
-    Eigen::VectorXd energyGradient;
-    double energyDT = 0.0;
-  };
   /// Pass 1: dynamics and the sample's inner solve, KKT factorisation and (per-sample
   /// layout) dF.
   void prepareSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g);
   /// Pass 3: the chain rule through the splines, the energy.
   void finishSample(Workspace& w, int sample, double duration, MultiContactResult& r, MultiContactGradient& g,
-                    ChunkSum& sum);
+                    ChunkedEnergyGradient::Sum& sum);
   /// Pass 2 of the all-samples layout: one block-diagonal sparse factorisation and solve.
   void solveAllSamples();
 
@@ -82,7 +77,7 @@ class MultiContactGradientEvaluator {
   SensitivitySettings sensitivitySettings_;
   Eigen::MatrixXd controlPoints_;
   std::vector<std::unique_ptr<Workspace>> workspaces_;
-  std::vector<ChunkSum> chunkSums_;
+  ChunkedEnergyGradient chunkSums_;
   std::vector<BilevelSample> bilevel_;  ///< one per sample
   std::unique_ptr<SparseKktFactor> allSamplesFactor_;  ///< KktLayout::AllSamples
   bool sized_ = false;  ///< an evaluation has run: every sample's buffers are sized (NoMallocScope)
