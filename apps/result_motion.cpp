@@ -4,6 +4,7 @@
 #include "apps/json_io.hpp"
 #include "core/errors.hpp"
 #include "outer_nlp/scenario_run.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt::cli {
 
@@ -93,7 +94,12 @@ Scenario scenarioOfResult(const ResultMotion& result, const std::filesystem::pat
   const std::filesystem::path file = scenarioFile.empty() ? result.scenario : scenarioFile;
   if (!std::filesystem::exists(file))
     throw InputError(result.file.string() + ": scenario: " + file.string() + ": no such file");
-  const ContactForces forces = parseContactForces(result.contactForces);
+  std::string forces;
+  try {
+    forces = contactForceFormulation(result.contactForces).name;
+  } catch (const InputError& e) {
+    throw InputError(result.file.string() + ": contact_forces: " + e.what());
+  }
   Scenario scenario = loadScenario(file, forces);
   ScenarioOverrides overrides;
   overrides.contactForces = forces;
@@ -127,7 +133,7 @@ Eigen::VectorXd pointOfResult(MotionProblem& problem, const ResultMotion& result
   const Scenario& scenario = problem.scenario();
   if (result.forceVariables.size() != problem.forceVariableCount())
     throw InputError(result.file.string() + ": contact_force_variables: " + std::to_string(result.forceVariables.size()) +
-                     " values, the scenario's " + toString(scenario.contactForces) + " formulation has " +
+                     " values, the scenario's " + scenario.contactForces + " formulation has " +
                      std::to_string(problem.forceVariableCount()));
   return problem.pointFromMotion(scenario.initialMotion->parameters, scenario.initialMotion->duration, result.forceVariables);
 }

@@ -29,6 +29,7 @@
 #include "outer_nlp/motion_solve.hpp"
 #include "outer_nlp/scenario_run.hpp"
 #include "outer_nlp/scenario.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt::cli {
 
@@ -90,8 +91,8 @@ void writeCheckpoint(const std::string& out, MotionProblem& problem, const RunRe
 
 int runMotion(const RunOptions& o) {
   // The formulation first: the file's checks that depend on it see the one that will run.
-  std::optional<ContactForces> contactForces;
-  if (!o.contactForces.empty()) contactForces = parseContactForces(o.contactForces);
+  std::optional<std::string> contactForces;
+  if (!o.contactForces.empty()) contactForces = contactForceFormulation(o.contactForces).name;
   Scenario scenario = loadScenario(o.scenario, contactForces, o.allowNonPhysicalInertia);
   ScenarioOverrides overrides;
   if (!o.configurationOptimisation.empty()) overrides.configurationOptimisation = o.configurationOptimisation == "on";
@@ -114,7 +115,7 @@ int runMotion(const RunOptions& o) {
     std::cout << ", " << c.surface.name;
     if (c.window) std::cout << " [" << c.start << ", " << c.end << "] s";
   }
-  std::cout << (scenario.contacts.empty() ? "" : std::string("; contact forces: ") + toString(scenario.contactForces) +
+  std::cout << (scenario.contacts.empty() ? "" : std::string("; contact forces: ") + scenario.contactForces +
                                                      (problem.bilevel() ? " (inner solver " + scenario.inner.solverName + ")" : ""))
             << "\n"
             << "  " << problem.variableCount() << " variables, " << problem.constraintCount() << " constraints, "

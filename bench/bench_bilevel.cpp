@@ -41,7 +41,7 @@ const std::vector<BilevelCase>& bilevelCases() {
 Scenario bilevelScenario(const BilevelCase& c, const std::string& solver, KktBackend backend) {
   Scenario scenario = loadScenario(std::filesystem::path(MCOPT_SOURCE_DIR) / "scenarios" / c.file);
   scenario.samples = 100;
-  scenario.contactForces = ContactForces::Bilevel;
+  scenario.contactForces = "bilevel";
   scenario.inner.solverName = solver;
   scenario.sensitivity.backend = backend;
   return scenario;

@@ -8,13 +8,12 @@
 
 namespace mcopt {
 
-ContactForceParametrization::ContactForceParametrization(ContactForces kind,
+ContactForceParametrization::ContactForceParametrization(Layout layout,
                                                          const std::vector<std::array<double, 2>>& windows,
                                                          const std::vector<double>& u,
                                                          const std::vector<std::vector<bool>>& active,
                                                          int controlPoints, int firstVariable)
     : windows_(windows), firstVariable_(firstVariable) {
-  if (kind == ContactForces::Bilevel) throw InputError("contact forces: the bilevel formulation has no force variables");
   const BSplineBasis basis(controlPoints);
   int next = firstVariable;
   terms_.resize(windows.size());
@@ -24,7 +23,7 @@ ContactForceParametrization::ContactForceParametrization(ContactForces kind,
     terms.resize(u.size());
     for (std::size_t s = 0; s < u.size(); ++s) {
       if (!active[i][s]) continue;
-      if (kind == ContactForces::Variables) {
+      if (layout == Layout::PerSample) {
         terms[s].push_back({next, 1.0});
         next += 6;
         continue;
@@ -35,7 +34,7 @@ ContactForceParametrization::ContactForceParametrization(ContactForces kind,
         if (b.value[static_cast<std::size_t>(l)] != 0.0)
           terms[s].push_back({next + 6 * (b.first + l), b.value[static_cast<std::size_t>(l)]});
     }
-    if (kind == ContactForces::Splines) next += 6 * controlPoints;
+    if (layout == Layout::Splines) next += 6 * controlPoints;
   }
   variableCount_ = next - firstVariable;
 }

@@ -34,7 +34,12 @@ class ContactForceParametrization {
   /// windows: per contact, the normalised window [u0, u1]; u: the normalised sample times;
   /// active: per contact and sample, in contact there (inside the window; at an instant sampled
   /// twice, the twin on the window's side). firstVariable: global index of z's first entry.
-  ContactForceParametrization(ContactForces kind, const std::vector<std::array<double, 2>>& windows,
+  /// How a contact's wrench is laid out in z.
+  enum class Layout {
+    Splines,    ///< a clamped cubic B-spline per component over the contact's window, `controlPoints` each
+    PerSample,  ///< six variables per sample in contact
+  };
+  ContactForceParametrization(Layout layout, const std::vector<std::array<double, 2>>& windows,
                               const std::vector<double>& u, const std::vector<std::vector<bool>>& active,
                               int controlPoints, int firstVariable);
 

@@ -8,6 +8,7 @@
 #include "core/dynamics_data.hpp"
 #include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt {
 
@@ -84,12 +85,8 @@ EnergyBalance energyBalanceOf(const MotionProblem& fine, const SampledPhysics& p
   b.instants = static_cast<int>(p.time.size());
   if (scenario.contacts.empty())
     b.wrenchesBetweenSamples = "balance";
-  else if (scenario.contactForces == ContactForces::Bilevel)
-    b.wrenchesBetweenSamples = "inner problem";
-  else if (scenario.contactForces == ContactForces::Splines)
-    b.wrenchesBetweenSamples = "splines";
   else
-    b.wrenchesBetweenSamples = "linear interpolation";
+    b.wrenchesBetweenSamples = contactForceFormulation(scenario.contactForces).betweenSamples;
 
   const DynamicsModel& model = fine.model();  // the robot without the ball
   DynamicsData data(model);

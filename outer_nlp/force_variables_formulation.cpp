@@ -22,15 +22,14 @@ namespace {
 
 class ForceVariablesFormulation final : public ContactForceFormulation {
  public:
-  explicit ForceVariablesFormulation(const FormulationContext& c)
-      : scenario_(c.scenario), outputs_(c.outputs), support_(c.support), contactRows_(c.contactRows) {
+  ForceVariablesFormulation(const FormulationContext& c, ContactForceParametrization::Layout layout)
+      : scenario_(c.scenario), outputs_(c.outputs), support_(c.support), contactRows_(c.contactRows), layout_(layout) {
     if (!scenario_.contacts.empty())
-      forces_.emplace(scenario_.contactForces, c.windows, c.sampleTimes, c.active, scenario_.forceControlPoints,
-                      c.firstVariable);
+      forces_.emplace(layout, c.windows, c.sampleTimes, c.active, scenario_.forceControlPoints, c.firstVariable);
   }
 
   int variableCount() const override { return forces_ ? forces_->variableCount() : 0; }
-  bool variablesIndependentOfGrid() const override { return scenario_.contactForces == ContactForces::Splines; }
+  bool variablesIndependentOfGrid() const override { return layout_ == ContactForceParametrization::Layout::Splines; }
 
   void variableBounds(Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) const override {
     // A contact whose model holds a force alone (the point contact): its moment variables are
@@ -128,13 +127,18 @@ class ForceVariablesFormulation final : public ContactForceFormulation {
   const SampleOutputs& outputs_;
   const ContactAdmissibilityRows& support_;
   const std::vector<ContactAdmissibilityRows>& contactRows_;
+  ContactForceParametrization::Layout layout_;
   std::optional<ContactForceParametrization> forces_;  ///< none without environment contacts
 };
 
 }  // namespace
 
-std::unique_ptr<ContactForceFormulation> makeForceVariablesFormulation(const FormulationContext& context) {
-  return std::make_unique<ForceVariablesFormulation>(context);
+std::unique_ptr<ContactForceFormulation> makeForceSplinesFormulation(const FormulationContext& context) {
+  return std::make_unique<ForceVariablesFormulation>(context, ContactForceParametrization::Layout::Splines);
+}
+
+std::unique_ptr<ContactForceFormulation> makePerSampleForcesFormulation(const FormulationContext& context) {
+  return std::make_unique<ForceVariablesFormulation>(context, ContactForceParametrization::Layout::PerSample);
 }
 
 }  // namespace mcopt

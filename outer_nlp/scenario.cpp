@@ -11,6 +11,7 @@
 #include "core/kinematics.hpp"
 #include "core/spatial.hpp"
 #include "inner_qp/inner_solver.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 #include "core/yaml_fields.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
@@ -142,55 +143,24 @@ TaskSpec readTask(const std::filesystem::path& file, const YAML::Node& node, con
 }
 
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia);
+                      std::optional<std::string> contactForces, bool allowNonPhysicalInertia);
 
 }  // namespace
 
-namespace {
-struct ContactForcesName {
-  ContactForces forces;
-  const char* name;
-};
-constexpr ContactForcesName kContactForcesNames[] = {
-    {ContactForces::Bilevel, "bilevel"}, {ContactForces::Splines, "splines"}, {ContactForces::Variables, "variables"}};
-}  // namespace
-
-const char* toString(ContactForces forces) {
-  for (const ContactForcesName& f : kContactForcesNames)
-    if (f.forces == forces) return f.name;
-  return "bilevel";
-}
-
-const std::vector<std::string>& contactForcesNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> all;
-    for (const ContactForcesName& f : kContactForcesNames) all.emplace_back(f.name);
-    return all;
-  }();
-  return names;
-}
-
-ContactForces parseContactForces(const std::string& name) {
-  for (const ContactForcesName& f : kContactForcesNames)
-    if (name == f.name) return f.forces;
-  throw InputError("unknown contact-force formulation '" + name + "' (expected " + alternatives(contactForcesNames()) +
-                   ")");
-}
-
-Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces,
+Scenario loadScenario(const std::filesystem::path& file, std::optional<std::string> contactForces,
                       bool allowNonPhysicalInertia) {
   return loadScenario(yaml::loadFile(file), file, contactForces, allowNonPhysicalInertia);
 }
 
 Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia) {
+                      std::optional<std::string> contactForces, bool allowNonPhysicalInertia) {
   return yaml::reading(file, [&] { return readScenario(root, file, contactForces, allowNonPhysicalInertia); });
 }
 
 namespace {
 
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces, bool allowNonPhysicalInertia) {
+                      std::optional<std::string> contactForces, bool allowNonPhysicalInertia) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
   yaml::rejectUnknownKeys(file, root, "",
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
@@ -353,12 +323,12 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (root["contact_forces"]) {
     const YAML::Node node = root["contact_forces"];
     try {
-      s.contactForces = parseContactForces(yaml::text(file, node, "contact_forces"));
+      s.contactForces = contactForceFormulation(yaml::text(file, node, "contact_forces")).name;
     } catch (const InputError& e) {
       throw InputError(where(file, node, "contact_forces") + e.what());
     }
   }
-  if (contactForces) s.contactForces = *contactForces;
+  if (contactForces) s.contactForces = contactForceFormulation(*contactForces).name;
   if (root["force_control_points"])
     s.forceControlPoints = yaml::integerAtLeast(file, root["force_control_points"], "force_control_points", 4);
   if (root["inner"]) readInnerSettings(file, root["inner"], s);
@@ -414,17 +384,18 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                            "the scenario has no contact besides the reference body's, where every formulation is the same "
                            "problem");
         if (!only.IsSequence() || only.size() == 0)
-          throw InputError(where(file, only, onlyField) + "expected a non-empty list of formulations (bilevel, splines, variables)");
+          throw InputError(where(file, only, onlyField) + "expected a non-empty list of formulations (" +
+                           alternatives(contactForcesNames()) + ")");
         for (std::size_t i = 0; i < only.size(); ++i) {
           const std::string item = onlyField + "[" + std::to_string(i) + "]";
-          ContactForces forces;
+          std::string forces;
           try {
-            forces = parseContactForces(yaml::text(file, only[i], item));
+            forces = contactForceFormulation(yaml::text(file, only[i], item)).name;
           } catch (const InputError& e) {
             throw InputError(where(file, only[i], item) + e.what());
           }
           if (std::find(c.forContactForces.begin(), c.forContactForces.end(), forces) != c.forContactForces.end())
-            throw InputError(where(file, only[i], item) + "'" + toString(forces) + "' is listed twice");
+            throw InputError(where(file, only[i], item) + "'" + forces + "' is listed twice");
           c.forContactForces.push_back(forces);
         }
       }
@@ -440,7 +411,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
         // Per-sample variables (epigraph slacks, wrenches as variables) do not carry over
         // from one grid to another; the spline parameters and force splines do.
         if (s.energyForm == EnergyForm::Epigraph || c.energyForm == EnergyForm::Epigraph ||
-            (!s.contacts.empty() && s.contactForces == ContactForces::Variables))
+            (!s.contacts.empty() && contactForceFormulation(s.contactForces).variablesPerSample))
           throw InputError(where(file, stage["samples"], field + ".samples") +
                            "the epigraph form and contact_forces: variables have variables per sample; a stage "
                            "cannot change the samples");

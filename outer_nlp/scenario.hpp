@@ -59,18 +59,6 @@ struct ThrownBall {
   double gravity = 9.81;             ///< gravity's magnitude (along −z) [m/s²]
 };
 
-/// How the contact wrenches enter the outer problem (formulation.md §9).
-enum class ContactForces {
-  Bilevel,    ///< an inner problem per sample picks them; exact gradients through its KKT system
-  Splines,    ///< each wrench component of a non-reference contact is a B-spline of NLP variables
-  Variables,  ///< each wrench of a non-reference contact at each sample is an NLP variable
-};
-const char* toString(ContactForces forces);
-/// "bilevel", "splines" or "variables"; throws InputError otherwise (the message lists them).
-ContactForces parseContactForces(const std::string& name);
-/// The formulations' names, in the order documents list them.
-const std::vector<std::string>& contactForcesNames();
-
 /// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/theory/outer-problem.md, "Hessian
 /// and convergence").
 enum class HessianOption {
@@ -145,7 +133,9 @@ struct Scenario {
   /// (docs/theory/outer-problem.md, "Multi-contact").
   double closurePositionTolerance = 1e-3;     ///< [m]
   double closureOrientationTolerance = 1e-3;  ///< [rad], on sin θ of the error rotation
-  ContactForces contactForces = ContactForces::Bilevel;
+  /// How the contact wrenches enter the outer problem (formulation.md §9): a registered
+  /// formulation's name (formulation_registry.hpp).
+  std::string contactForces = "bilevel";
   int forceControlPoints = 9;      ///< per wrench spline (splines formulation), over its contact's window
   MultiContactSettings inner;      ///< bilevel: contact model and inner solver
   SensitivitySettings sensitivity; ///< bilevel: KKT backend
@@ -213,9 +203,9 @@ struct Scenario {
     /// weight shift: Gauss–Newton first makes the bilevel run converge in seconds and keeps the
     /// `variables` one from converging; docs/theory/outer-problem.md, "Multi-contact"), and
     /// `mcopt run --contact-forces` chooses the formulation after the file is read.
-    std::vector<ContactForces> forContactForces;
+    std::vector<std::string> forContactForces;
     /// Whether the stage runs with that formulation.
-    bool runsWith(ContactForces forces) const {
+    bool runsWith(const std::string& forces) const {
       return forContactForces.empty() ||
              std::find(forContactForces.begin(), forContactForces.end(), forces) != forContactForces.end();
     }
@@ -247,7 +237,7 @@ std::string exactHessianRefusal(const Scenario& scenario);
 /// whose `hessian: exact` the bilevel formulation refuses is accepted with `splines`).
 /// `allowNonPhysicalInertia` (`--allow-nonphysical-inertia`) loads a URDF whose inertias a real
 /// body cannot have, as the file's `allow_nonphysical_inertia: true` does, with a warning each.
-Scenario loadScenario(const std::filesystem::path& file, std::optional<ContactForces> contactForces = std::nullopt,
+Scenario loadScenario(const std::filesystem::path& file, std::optional<std::string> contactForces = std::nullopt,
                       bool allowNonPhysicalInertia = false);
 /// (A scenario already parsed as YAML: outer_nlp/scenario_yaml.hpp.)
 

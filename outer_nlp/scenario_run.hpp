@@ -27,7 +27,7 @@ namespace mcopt {
 /// the command line and Python parse their text; an unset field leaves the scenario's.
 struct ScenarioOverrides {
   std::optional<bool> configurationOptimisation;
-  std::optional<ContactForces> contactForces;  ///< formulation.md §9
+  std::optional<std::string> contactForces;  ///< formulation.md §9
   std::optional<int> maxIterations;            ///< Ipopt's max_iter for the motion and the cap of every stage, ≥ 0
   std::optional<std::string> innerSolver;      ///< a registered inner solver (bilevel, formulation.md §7)
   /// The motion's and every continuation stage's Hessian. A stage left differing from the

@@ -7,6 +7,7 @@
 #include "core/errors.hpp"
 #include "core/yaml_fields.hpp"
 #include "inner_qp/inner_solver.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 #include "outer_nlp/scenario.hpp"
 #include "outer_nlp/scenario_yaml.hpp"
 
@@ -115,9 +116,9 @@ const std::vector<std::string>& hessianOptionNames() {
 }
 
 std::string exactHessianRefusal(const Scenario& s) {
-  if (!s.contacts.empty() && s.contactForces == ContactForces::Bilevel)
-    return "the bilevel formulation's inner optimum is not polynomial in the state; use contact_forces: splines or "
-           "variables, or hessian: sample-differences";
+  if (!s.contacts.empty() && contactForceFormulation(s.contactForces).innerProblem)
+    return "the " + s.contactForces + " formulation's inner optimum is not polynomial in the state; use hessian: "
+           "sample-differences or gauss-newton";
   if (!s.contacts.empty())
     return "contact '" + s.contacts.front().surface.name + "' is held by construction, its loop's closing joints following the others "
            "(docs/theory/outer-problem.md, \"Closure by construction\"), and the stencils have no rule for that map; use "

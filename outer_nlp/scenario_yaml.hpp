@@ -17,7 +17,6 @@
 namespace mcopt {
 
 struct Scenario;             // outer_nlp/scenario.hpp
-enum class ContactForces;    // outer_nlp/scenario.hpp
 
 /// The `throw` task (formulation.md §10; docs/reference/scenario-file.md, "Throw"; outer_nlp/throw_task.cpp):
 /// `node` is tasks[i] with `kind: throw`; appends its two rows (BallFlightTask landing and
@@ -41,6 +40,6 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.
 Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
-                      std::optional<ContactForces> contactForces = std::nullopt, bool allowNonPhysicalInertia = false);
+                      std::optional<std::string> contactForces = std::nullopt, bool allowNonPhysicalInertia = false);
 
 }  // namespace mcopt

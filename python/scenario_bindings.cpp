@@ -23,6 +23,7 @@
 #include "python/robot_handle.hpp"
 #include "study/field_path.hpp"
 #include "study/scenario_tree.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt::python {
 
@@ -33,13 +34,13 @@ struct ScenarioHandle {
   YAML::Node root;  ///< the scenario's fields as read and changed; side files relative to `file`
   /// The formulation chosen when it was opened, over the file's: as `mcopt run --contact-forces`,
   /// it is the one the file's checks see (a bilevel file with `hessian: exact` opens for splines).
-  std::optional<ContactForces> contactForces;
+  std::optional<std::string> contactForces;
   Scenario scenario;
 };
 
-std::optional<ContactForces> formulationArgument(const std::optional<std::string>& name) {
+std::optional<std::string> formulationArgument(const std::optional<std::string>& name) {
   if (!name) return std::nullopt;
-  return parseContactForces(*name);
+  return contactForceFormulation(*name).name;
 }
 
 /// A YAML scalar as the Python value it reads as: int, float, bool, None or str.
@@ -139,7 +140,7 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
              const std::optional<int>& refine) {
   // Another formulation than the one it was opened with is checked against the file as the
   // command line's is (loadScenario's contactForces): the file's checks see the run's formulation.
-  const std::optional<ContactForces> forces = formulationArgument(contactForces);
+  const std::optional<std::string> forces = formulationArgument(contactForces);
   Scenario scenario = forces && forces != s.contactForces ? loadScenario(s.root, s.file, forces) : s.scenario;
   ScenarioOverrides overrides;
   overrides.maxIterations = maxIterations;
@@ -202,6 +203,15 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
 }  // namespace
 
 void bindScenario(py::module_& m) {
+  m.def(
+      "contact_force_formulations",
+      [] {
+        py::dict out;
+        for (const ContactForceFormulationEntry& e : contactForceFormulations()) out[py::str(e.name)] = e.description;
+        return out;
+      },
+      "The registered contact-force formulations (a scenario's contact_forces), name → what it is, in the order the "
+      "documents list them.");
   py::class_<ScenarioHandle, std::shared_ptr<ScenarioHandle>>(m, "Scenario", R"doc(
 A motion-optimisation scenario (docs/reference/scenario-file.md). Fields are read and changed by field path,
 as a sweep names them (docs/reference/studies.md): `s["samples"] = 40`, `s["tasks[kick].target[0]"]`,
@@ -218,7 +228,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
            }),
            py::arg("file"), py::arg("contact_forces") = py::none(),
            "Reads and validates a scenario file (errors as `mcopt run` reports them). `contact_forces`: "
-           "'bilevel', 'splines' or 'variables' over the file's, as `mcopt run --contact-forces`, "
+           "a name of mcopt.contact_force_formulations() over the file's, as `mcopt run --contact-forces`, "
            "before the file's checks (a bilevel file with `hessian: exact` opens with 'splines').")
       .def_property_readonly("file", [](const ScenarioHandle& s) { return s.file; }, "the scenario file (side files are relative to it)")
       .def_property_readonly("robot", [](const ScenarioHandle& s) {
@@ -226,7 +236,7 @@ was. `run()` optimises it as `mcopt run` does.)doc")
                                              loadContactSurfaces(s.scenario.contactSurfacesFile, s.scenario.robot));
       }, "The scenario's robot with its actuators and contact surfaces (a mcopt.Robot).")
       .def_property_readonly("joint_names", [](const ScenarioHandle& s) { return s.scenario.robot.jointNames(); }, "joints in the order of every joint array of a result")
-      .def_property_readonly("contact_forces", [](const ScenarioHandle& s) { return std::string(toString(s.scenario.contactForces)); }, "the contact-force formulation: 'bilevel', 'splines' or 'variables'")
+      .def_property_readonly("contact_forces", [](const ScenarioHandle& s) { return s.scenario.contactForces; }, "the contact-force formulation: a name of mcopt.contact_force_formulations()")
       .def(
           "__getitem__",
           [](const ScenarioHandle& s, const std::string& path) {

@@ -37,7 +37,7 @@ std::vector<Variant> variants() {
   Scenario lean = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
   lean.samples = 12;
   out.push_back({"lean reach, bilevel", lean});
-  lean.contactForces = ContactForces::Variables;
+  lean.contactForces = "variables";
   out.push_back({"lean reach, variables", lean});
   return out;
 }

@@ -18,6 +18,7 @@
 #include "core/kinematics.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "outer_nlp/smooth_maximum.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt {
 
@@ -196,7 +197,7 @@ TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jaco
     if (c.bilevel) s.controlPoints = 11;
     s.outputSamples = 20;
     s.hessian = HessianOption::GaussNewton;
-    if (c.bilevel) s.contactForces = ContactForces::Bilevel;
+    if (c.bilevel) s.contactForces = "bilevel";
     if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
     if (!c.bilevel && !c.epigraph) s.accelerationWeight = 1e-3;
     MotionProblem problem(s);
@@ -253,9 +254,9 @@ TEST_CASE("sample-differences Hessian: the kick against differences of the exact
 }
 
 TEST_CASE("sample-differences Hessian: every contact-force formulation", "[outer][hessian][multi-contact]") {
-  for (const ContactForces forces : {ContactForces::Splines, ContactForces::Variables, ContactForces::Bilevel}) {
+  for (const std::string& forces : contactForcesNames()) {
 #ifdef MCOPT_UNDER_SANITIZERS
-    if (forces == ContactForces::Variables) continue;  // the splines' code path, more columns; Release runs it
+    if (forces == "variables") continue;  // the splines' code path, more columns; Release runs it
 #endif
     Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
     // The bundled 15 control points on 10 samples took 200 s under the sanitizers, 11 took 118 s;
@@ -275,7 +276,7 @@ TEST_CASE("sample-differences Hessian: every contact-force formulation", "[outer
     const Eigen::VectorXd x = test::perturbedMotion(problem, 0.02, 11);
     double generic = 0.0;
     const double error = hessianError(problem, x, randomMultipliers(problem, 13), 1.0, &generic);
-    INFO(toString(forces) << ": against central differences " << error << ", against the generic differences " << generic << "; infeasible samples "
+    INFO(forces << ": against central differences " << error << ", against the generic differences " << generic << "; infeasible samples "
                           << problem.infeasibleSamples());
     CHECK(error < 1e-3);
   }
@@ -295,18 +296,18 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
   struct Case {
     const char* name;
     const char* scenario;
-    ContactForces forces;
+    std::string forces;
     bool freeDuration, epigraph, everyTask;
     std::string model;
     double accelerationWeight;
   };
   const Case cases[] = {
-      {"kick, fixed T", "hrp2_kick.yaml", ContactForces::Bilevel, false, false, false, "report", 0.0},
-      {"kick, free T, regularised", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, false, "report", 1e-3},
-      {"kick, epigraph", "hrp2_kick.yaml", ContactForces::Bilevel, false, true, false, "report", 0.0},
-      {"kick, pyramid, free T", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, false, "pyramid", 0.0},
-      {"kick, every task kind, free T", "hrp2_kick.yaml", ContactForces::Bilevel, true, false, true, "report", 0.0},
-      {"throw, one foot, free T (free release)", "hrp2_throw_one_foot.yaml", ContactForces::Bilevel, true, false, false, "wrench-cone", 0.0},
+      {"kick, fixed T", "hrp2_kick.yaml", "bilevel", false, false, false, "report", 0.0},
+      {"kick, free T, regularised", "hrp2_kick.yaml", "bilevel", true, false, false, "report", 1e-3},
+      {"kick, epigraph", "hrp2_kick.yaml", "bilevel", false, true, false, "report", 0.0},
+      {"kick, pyramid, free T", "hrp2_kick.yaml", "bilevel", true, false, false, "pyramid", 0.0},
+      {"kick, every task kind, free T", "hrp2_kick.yaml", "bilevel", true, false, true, "report", 0.0},
+      {"throw, one foot, free T (free release)", "hrp2_throw_one_foot.yaml", "bilevel", true, false, false, "wrench-cone", 0.0},
   };
   int compared = 0;
   for (const Case& c : cases) {
@@ -317,7 +318,7 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
 #endif
     // The kick's cases measure its smooth maximum (kick()); the other scenarios keep their own.
     Scenario s = std::string(c.scenario) == "hrp2_kick.yaml" ? kick(12) : loadScenario(test::sourceDir() / "scenarios" / c.scenario);
-    s.samples = c.forces == ContactForces::Bilevel ? 12 : 8;
+    s.samples = c.forces == "bilevel" ? 12 : 8;
     if (s.ball) {
       // The release (0.6 of the motion) on a sample; every optional row of the throw bounded.
       s.samples = 11;
@@ -354,7 +355,7 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   // The bilevel formulation with environment contacts: the inner optimum is not polynomial
   // in the state (a command-line override meets the problem's own check).
   Scenario lean = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
-  lean.contactForces = ContactForces::Bilevel;
+  lean.contactForces = "bilevel";
   lean.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(lean), Catch::Matchers::Contains("hessian: exact: the bilevel formulation"));
   // In the file and in a continuation stage (the bundled throw is bilevel on two soles):
@@ -385,9 +386,9 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
       "window.yaml");
   CHECK_THROWS_WITH(loadScenario(windowFile), Catch::Matchers::Contains("contact 'r_sole' is held by construction"));
   // The formulation a run chooses (`mcopt run --contact-forces`) is the one checked.
-  CHECK_THROWS_WITH(loadScenario(throwFile, ContactForces::Splines),
+  CHECK_THROWS_WITH(loadScenario(throwFile, "splines"),
                     Catch::Matchers::Contains("contact 'r_sole' is held by construction"));
-  CHECK_THROWS_WITH(loadScenario(heldFile, ContactForces::Bilevel),
+  CHECK_THROWS_WITH(loadScenario(heldFile, "bilevel"),
                     Catch::Matchers::Contains(heldFile.string() + ":") &&
                         Catch::Matchers::Contains(": hessian: exact: the bilevel formulation"));
   // A stage for the other formulations alone is not refused for the file's bilevel, and is

@@ -15,6 +15,7 @@
 #include "core/trajectory_evaluation.hpp"
 #include "outer_nlp/motion_problem.hpp"
 #include "sensitivity/bilevel_sample.hpp"
+#include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt {
 
@@ -49,7 +50,7 @@ void addHandContact(Scenario& s, double start, double end) {
 
 TEST_CASE("multi-contact outer problem: exact derivatives of every formulation", "[outer][multi-contact]") {
   const int samples = 12;
-  for (const ContactForces forces : {ContactForces::Splines, ContactForces::Variables, ContactForces::Bilevel}) {
+  for (const std::string& forces : contactForcesNames()) {
     for (const bool hand : {false, true}) {
       for (const bool freeDuration : {false, true}) {
 #ifdef MCOPT_UNDER_SANITIZERS
@@ -68,9 +69,9 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
         // h = 1e-6 read as 1e-6 errors in the single-level formulations; at h = 3e-6 noise and
         // truncation are both below 4e-7 there. The bilevel outputs curve more (the inner
         // optimum): their truncation at 3e-6 is 3e-6, at 1e-6 below 5e-7.
-        const double h = forces == ContactForces::Bilevel ? 1e-6 : 3e-6;
+        const double h = forces == "bilevel" ? 1e-6 : 3e-6;
         const test::DerivativeErrors e = test::derivativeErrors(problem, x, h);
-        INFO(toString(forces) << (hand ? ", three contacts" : ", two contacts") << (freeDuration ? ", free T" : "")
+        INFO(forces << (hand ? ", three contacts" : ", two contacts") << (freeDuration ? ", free T" : "")
                               << ": gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern "
                               << e.offPattern << "; infeasible samples " << problem.infeasibleSamples());
         CHECK(e.gradient < 1e-6);
@@ -88,7 +89,7 @@ TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact 
   // single-level formulations hold the hand's moment variables at zero (their bounds) and its
   // own two rows (f_z, the friction cone). The outer gradient and Jacobian against central
   // differences as for the other formulations' hands above.
-  for (const ContactForces forces : {ContactForces::Bilevel, ContactForces::Splines, ContactForces::Variables}) {
+  for (const std::string& forces : contactForcesNames()) {
     Scenario s = weightShift(12);
     s.contactForces = forces;
     s.fixStart = s.fixEnd = false;
@@ -100,9 +101,9 @@ TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact 
     Eigen::VectorXd lower, upper;
     problem.variableBounds(lower, upper);
     x = x.cwiseMax(lower).cwiseMin(upper);
-    const double h = forces == ContactForces::Bilevel ? 1e-6 : 3e-6;  // as in the test above
+    const double h = forces == "bilevel" ? 1e-6 : 3e-6;  // as in the test above
     const test::DerivativeErrors e = test::derivativeErrors(problem, x, h);
-    INFO(toString(forces) << ": gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern "
+    INFO(forces << ": gradient " << e.gradient << ", Jacobian " << e.jacobian << ", off the pattern "
                           << e.offPattern << "; infeasible samples " << problem.infeasibleSamples());
     CHECK(e.gradient < 1e-6);
     CHECK(e.jacobian < 1e-6);
@@ -117,13 +118,13 @@ TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact 
       ++active;
       const Eigen::VectorXd hand = physics.wrenches[2].col(k);
       CHECK(hand.tail<3>().cwiseAbs().maxCoeff() == 0.0);  // no moment
-      if (forces == ContactForces::Bilevel)                 // the inner optimum holds its cone
+      if (forces == "bilevel")                 // the inner optimum holds its cone
         CHECK(hand.head<2>().norm() <= s.contacts.back().surface.friction * hand[2] + 1e-9);
     }
     CHECK(active > 0);
     // Single-level: the hand's rows are its own model's two a sample (f_z, the cone), the
     // soles' the wrench cone's 17.
-    if (forces != ContactForces::Bilevel) CHECK(handRows == 2 * active);
+    if (forces != "bilevel") CHECK(handRows == 2 * active);
   }
 }
 
@@ -171,7 +172,7 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
 TEST_CASE("multi-contact outer problem: the contact wrenches balance W0 at every sample", "[outer][multi-contact]") {
   // Σ_c wrenchToWorld_c F_c = W0 (formulation.md §5): eliminated exactly in the single-level
   // formulations, solved for by the inner problem in the bilevel one.
-  for (const ContactForces forces : {ContactForces::Splines, ContactForces::Variables, ContactForces::Bilevel}) {
+  for (const std::string& forces : contactForcesNames()) {
     Scenario s = weightShift(10);
     s.contactForces = forces;
     addHandContact(s, 0.5, 1.9);
@@ -192,12 +193,12 @@ TEST_CASE("multi-contact outer problem: the contact wrenches balance W0 at every
         wrenchToWorld(contactFrame(model, data, surfaces[c]->frame, surfaces[c]->placement), toWorld);
         sum += toWorld * physics.wrenches[c].col(k);
       }
-      if (forces == ContactForces::Bilevel && physics.innerStatus[static_cast<std::size_t>(k)] != "optimal") continue;
+      if (forces == "bilevel" && physics.innerStatus[static_cast<std::size_t>(k)] != "optimal") continue;
       worst = std::max(worst, (sum - data.referenceWrench).norm());
       load = std::max(load, data.referenceWrench.norm());
       handLoaded += physics.active[2][static_cast<std::size_t>(k)] && physics.wrenches[2](2, k) > 1e-6;
     }
-    INFO(toString(forces) << ": worst balance residual " << worst << " N for W0 up to " << load << "; samples with the hand loaded "
+    INFO(forces << ": worst balance residual " << worst << " N for W0 up to " << load << "; samples with the hand loaded "
                           << handLoaded);
     CHECK(load > 500.0);
     CHECK(worst <= 1e-9 * load);
@@ -206,11 +207,36 @@ TEST_CASE("multi-contact outer problem: the contact wrenches balance W0 at every
   }
 }
 
+TEST_CASE("multi-contact outer problem: the formulations come from one registry and act as it says",
+          "[outer][multi-contact]") {
+  REQUIRE(contactForcesNames() == std::vector<std::string>{"bilevel", "splines", "variables"});
+  CHECK_THROWS_WITH(contactForceFormulation("lagrangian"),
+                    "unknown contact-force formulation 'lagrangian' (expected bilevel, splines or variables)");
+  const Scenario base = weightShift(12);
+  for (const ContactForceFormulationEntry& entry : contactForceFormulations()) {
+    INFO(entry.name);
+    CHECK(&contactForceFormulation(entry.name) == &entry);
+    CHECK(!entry.description.empty());
+    Scenario s = base;
+    s.contactForces = entry.name;
+    const MotionProblem problem(s);
+    // The entry's traits are what the problem it makes does.
+    CHECK(problem.bilevel() == entry.innerProblem);
+    CHECK((problem.forceVariableCount() == 0) == entry.innerProblem);
+    // Per-sample variables: a finer grid has more of them; splines: as many.
+    Scenario finer = s;
+    finer.samples = 2 * s.samples - 1;
+    const MotionProblem fine(finer);
+    if (!entry.innerProblem) CHECK((fine.forceVariableCount() != problem.forceVariableCount()) == entry.variablesPerSample);
+    CHECK((exactHessianRefusal(s).find("inner optimum") != std::string::npos) == entry.innerProblem);
+  }
+}
+
 TEST_CASE("multi-contact outer problem: with the reference contact alone every formulation is the one-contact problem",
           "[outer][multi-contact]") {
   Scenario kick = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
   kick.samples = 25;
-  kick.contactForces = ContactForces::Bilevel;
+  kick.contactForces = "bilevel";
   MotionProblem reference(kick);
   std::mt19937 random(5);
   std::uniform_real_distribution<double> u(-0.1, 0.1);
@@ -220,7 +246,7 @@ TEST_CASE("multi-contact outer problem: with the reference contact alone every f
   reference.constraints(x, g0);
   reference.objectiveGradient(x, grad0);
   const double f0 = reference.objective(x);
-  for (const ContactForces forces : {ContactForces::Splines, ContactForces::Variables}) {
+  for (const std::string& forces : contactForcesNames()) {
     kick.contactForces = forces;
     MotionProblem problem(kick);
     REQUIRE(problem.variableCount() == reference.variableCount());
@@ -250,21 +276,21 @@ TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios eval
     // system the sensitivity must solve in the least-norm sense, not by an LU that returned
     // NaN (Hager–Higham estimated it well conditioned; sensitivity/inner_sensitivity.cpp).
     struct Run {
-      ContactForces forces;
+      std::string forces;
       const char* innerSolver;
     };
-    for (const Run run : {Run{ContactForces::Bilevel, "active-set"}, Run{ContactForces::Bilevel, "slsqp"},
-                          Run{ContactForces::Bilevel, "ipopt"}, Run{ContactForces::Splines, ""},
-                          Run{ContactForces::Variables, ""}}) {
+    for (const Run& run : {Run{"bilevel", "active-set"}, Run{"bilevel", "slsqp"},
+                          Run{"bilevel", "ipopt"}, Run{"splines", ""},
+                          Run{"variables", ""}}) {
       s.contactForces = run.forces;
-      if (run.forces == ContactForces::Bilevel) s.inner.solverName = run.innerSolver;
+      if (run.forces == "bilevel") s.inner.solverName = run.innerSolver;
       MotionProblem problem(s);
       const Eigen::VectorXd x = problem.initialPoint(s.start, s.end);
       Eigen::VectorXd g, gradient, jacobian(problem.jacobianNonZeros());
       problem.constraints(x, g);
       problem.objectiveGradient(x, gradient);
       problem.jacobianValues(x, jacobian);
-      INFO(name << ", " << toString(run.forces) << " " << run.innerSolver);
+      INFO(name << ", " << run.forces << " " << run.innerSolver);
       CHECK(std::isfinite(problem.objective(x)));
       CHECK(g.allFinite());
       CHECK(gradient.allFinite());

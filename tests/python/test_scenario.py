@@ -53,6 +53,16 @@ def test_the_registry_lists_the_task_kinds():
     assert all(isinstance(d, str) and d for d in kinds.values())
 
 
+def test_the_registry_lists_the_contact_force_formulations():
+    formulations = mcopt.contact_force_formulations()
+    assert list(formulations) == ["bilevel", "splines", "variables"]
+    assert all(isinstance(d, str) and d for d in formulations.values())
+    for name in formulations:
+        assert mcopt.Scenario(SOURCE / "scenarios" / "hrp2_weight_shift.yaml", contact_forces=name).contact_forces == name
+    with pytest.raises(mcopt.InputError, match="unknown contact-force formulation 'lagrangian'"):
+        mcopt.Scenario(SOURCE / "scenarios" / "hrp2_weight_shift.yaml", contact_forces="lagrangian")
+
+
 def test_a_refused_value_raises_the_loader_message_and_changes_nothing(mcopt_exe, tmp_path):
     s = mcopt.Scenario(KICK)
     with pytest.raises(mcopt.InputError) as raised:
