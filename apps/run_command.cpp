@@ -126,7 +126,7 @@ int runMotion(const RunOptions& o) {
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
 
-  if (scenario.configurationOptimisation) std::cout << "configuration optimisation (report §3.5)\n";
+  if (scenario.solve.configurationOptimisation) std::cout << "configuration optimisation (report §3.5)\n";
   if (scenario.initialMotion) std::cout << "  starting from the motion of " << o.startFrom << "\n";
   double lastCheckpoint = 0.0;
   ScenarioRunEvents events;
@@ -163,9 +163,9 @@ int runMotion(const RunOptions& o) {
   };
   events.onSolve = [&](const SolveStart& solve) {
     if (solve.joinedTorqueRows > 0)
-      std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.torqueScreening
+      std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.solve.torqueScreening
                 << " of their limit: solving again with them\n";
-    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(solve.scenario.hessian);
+    std::cout << "motion optimisation (Ipopt, Hessian: " << toString(solve.scenario.solve.hessian);
     if (solve.stages > 1) {
       std::cout << "; stage " << solve.stage + 1 << " of " << solve.stages << ": ν = "
                 << solve.scenario.actuators.frictionSharpness << " s/rad";
@@ -176,7 +176,7 @@ int runMotion(const RunOptions& o) {
       std::cout << ", " << solve.scenario.samples << " samples";
     }
     if (solve.problem.omittedTorqueRowCount() > 0)
-      std::cout << "; " << solve.problem.omittedTorqueRowCount() << " torque-limit rows below " << scenario.torqueScreening
+      std::cout << "; " << solve.problem.omittedTorqueRowCount() << " torque-limit rows below " << scenario.solve.torqueScreening
                 << " of their limit checked afterwards";
     std::cout << ")\n"
               << "   iter      energy [J]   violation   dual inf.     elapsed"
@@ -205,9 +205,9 @@ int runMotion(const RunOptions& o) {
   // killed during a round leaves it; the rounds write no checkpoints.
   std::optional<RefinedRun> refined;
   MotionProblem* finalProblem = &problem;
-  if (scenario.refineRounds > 0 && record.status == OuterStatus::Optimal) {
+  if (scenario.solve.refineRounds > 0 && record.status == OuterStatus::Optimal) {
     writeRunOutput(o.out, problem, record);
-    std::cout << "refinement (up to " << scenario.refineRounds << " rounds): verifying the optimum between its samples\n";
+    std::cout << "refinement (up to " << scenario.solve.refineRounds << " rounds): verifying the optimum between its samples\n";
     ScenarioRunEvents roundEvents;
     roundEvents.keepRunning = events.keepRunning;
     roundEvents.onRefinementRound = [](const RefinementRound& r) {
@@ -226,7 +226,7 @@ int runMotion(const RunOptions& o) {
         std::cout << " " << c.kind << " " << std::setprecision(3) << c.worst << (c.where.empty() ? "" : " (" + c.where + ")");
       std::cout << "\n";
     };
-    refined = refineRun(scenario, problem, std::move(record), scenario.refineRounds, VerificationSettings{}, roundEvents);
+    refined = refineRun(scenario, problem, std::move(record), scenario.solve.refineRounds, VerificationSettings{}, roundEvents);
     record = std::move(refined->record);
     if (refined->problem) finalProblem = refined->problem.get();
   }

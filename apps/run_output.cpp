@@ -222,7 +222,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"constraints", problem.constraintCount()},
                       {"jacobian_nonzeros", problem.jacobianNonZeros()}};
   if (!record.solver.evaluationError.empty()) result["solver"]["evaluation_error"] = record.solver.evaluationError;
-  result["solver"]["hessian"] = toString(scenario.hessian);
+  result["solver"]["hessian"] = toString(scenario.solve.hessian);
   // Where the time went: per iteration (since the previous one) and for the whole solve.
   auto split = [](const SolveTimings& now, const SolveTimings& before) {
     return Json{{"functions", now.functions - before.functions},

@@ -24,10 +24,10 @@ void optimisation(benchmark::State& state, const std::string& file, const std::s
   scenario.inner.solverName = solver;
   SolverOption limit;
   limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = kIterations;
-  scenario.solverOptions.push_back(limit);
+  scenario.solve.solverOptions.push_back(limit);
   OuterSolverSettings settings;
-  settings.options = scenario.solverOptions;
-  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
+  settings.options = scenario.solve.solverOptions;
+  settings.problemHessian = scenario.solve.hessian != HessianOption::LimitedMemory;
   OuterOutcome outcome;
   double violation = 0.0, seconds = 0.0;
   for (auto _ : state) {

@@ -22,7 +22,7 @@ Scenario kick(HessianOption hessian) {
   // bundled kick took the epigraph form (2026-11-26): the figures in docs/ compare with it.
   scenario.energyForm = EnergyForm::SmoothMaximum;
   scenario.smoothing = 0.01;
-  scenario.hessian = hessian;
+  scenario.solve.hessian = hessian;
   return scenario;
 }
 

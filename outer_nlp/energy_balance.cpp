@@ -40,8 +40,8 @@ Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval) {
       if (task.task->reads() == TaskQuantity::Ball)
         task.start = task.end = fine.ball->releaseTime;
   }
-  fine.torqueScreening = 0.0;
-  fine.continuation.clear();
+  fine.solve.torqueScreening = 0.0;
+  fine.solve.continuation.clear();
   return fine;
 }
 

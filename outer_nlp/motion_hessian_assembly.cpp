@@ -37,8 +37,8 @@ inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::ab
 
 void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                       const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
-  if (scenario_.hessian == HessianOption::SampleDifferences || scenario_.hessian == HessianOption::ConvexSampleDifferences ||
-      scenario_.hessian == HessianOption::GaussNewton || scenario_.hessian == HessianOption::Exact)
+  if (hessian_ == HessianOption::SampleDifferences || hessian_ == HessianOption::ConvexSampleDifferences ||
+      hessian_ == HessianOption::GaussNewton || hessian_ == HessianOption::Exact)
     sampleDifferencesHessian(x, objectiveFactor, multipliers, values);
   else
     NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
@@ -110,8 +110,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
 
     // Writes Bᵀ H B into the slot's LocalHessian: B maps the local spline parameters (k per joint, their
     // weights in q, q̇ = (1/T) dq/du, q̈ = (1/T²) d²q/du²) and the force columns to the state.
-    const bool convex = scenario_.hessian == HessianOption::ConvexSampleDifferences;
-    const bool exact = scenario_.hessian == HessianOption::Exact, freeDuration = durationIsFree();
+    const bool convex = hessian_ == HessianOption::ConvexSampleDifferences;
+    const bool exact = hessian_ == HessianOption::Exact, freeDuration = durationIsFree();
     // Symmetrises the leading d × d block of the state Hessian (and, for the convex option,
     // projects it onto the positive semidefinite cone).
     auto symmetrise = [&](int d) {
@@ -200,7 +200,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
       const double objectiveWeight = objectiveFactor * sampleWeights_[static_cast<std::size_t>(s)] * T;
       const auto lambda = sampleMultipliers_.col(s);
-      if (scenario_.hessian == HessianOption::GaussNewton) {
+      if (hessian_ == HessianOption::GaussNewton) {
         sampleGaussNewtonHessian(s, b, lambda, objectiveWeight, h);
         spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, closure_ ? &b.closureMap : nullptr, b.closed);
         continue;
@@ -364,7 +364,7 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       for (int c = 0; c < l.size; ++c)
         hessian(l.columns[static_cast<std::size_t>(r)], l.columns[static_cast<std::size_t>(c)]) += l.values(r, c);
 
-  if (durationIsFree() && scenario_.hessian == HessianOption::Exact) {
+  if (durationIsFree() && hessian_ == HessianOption::Exact) {
     // The samples and task instants brought theirs; the control-point rows (the velocity
     // limits, (x_second − x_first) / T) bring their own terms' curvature in T.
     const int column = parameterCount_;

@@ -103,7 +103,9 @@ RigidTransform supportPose(const DynamicsModel& model, const ContactSurface& sur
 
 }  // namespace
 
-MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows)
+MotionProblem::MotionProblem(const Scenario& scenario) : MotionProblem(scenario, {scenario.solve.hessian, {}}) {}
+
+MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions options)
     : scenario_(scenario),
       model_(scenario.robot, scenario.referenceBody, scenario.referencePose, scenario.gravity),
       parametrization_(scenario.robot.jointCount(), scenario.controlPoints, scenario.periodic),
@@ -112,11 +114,12 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
       support_(scenario.support, supportPose(model_, scenario.support), scenario.robot.totalMass() * scenario.gravity.norm(),
                scenario.inner.problem),
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
+  hessian_ = options.hessian;
   // The scenario file checks this with its line; a command-line override (--contact-forces)
   // or a hand-built scenario meets it here.
-  if (scenario_.hessian == HessianOption::Exact)
+  if (hessian_ == HessianOption::Exact)
     if (const std::string why = exactHessianRefusal(scenario_); !why.empty()) throw InputError("hessian: exact: " + why);
-  if (scenario_.hessian == HessianOption::Exact) {
+  if (hessian_ == HessianOption::Exact) {
     // The degree of a weighted output gradient along one state component (docs/reference/scenario-file.md,
     // "Hessian options"; tests/core/test_dynamics_degree.cpp): Γ and the reference
     // wrench are trigonometric of degree 2 in each joint angle (a moved body's world-frame
@@ -169,7 +172,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, std::vector<bool> omitted
     releaseSample_ = grid.releaseSample;
     for (int s = 0; s <= releaseSample_; ++s) loaded_[static_cast<std::size_t>(s)] = true;
   }
-  omittedTorqueRows_ = std::move(omittedTorqueRows);
+  omittedTorqueRows_ = std::move(options.omittedTorqueRows);
   if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
     throw InputError("motion problem: the torque-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());

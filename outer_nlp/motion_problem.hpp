@@ -123,13 +123,27 @@ struct SampledPhysics {
   std::optional<ReleaseState> release;
 };
 
+/// What a motion problem is built with besides the problem the scenario poses: the run's
+/// choices (scenario_run.hpp, motion_solve.hpp), not the scenario's.
+struct MotionProblemOptions {
+  /// The Hessian model lagrangianHessian assembles (docs/theory/outer-problem.md, "Hessian
+  /// options"); `exact` is refused where its stencils do not hold (exactHessianRefusal).
+  HessianOption hessian = HessianOption::SampleDifferences;
+  /// Empty, or one flag per joint and sample (index s · n + j): those torque-limit rows are
+  /// left out of the NLP — torque-limit screening (formulation.md §10;
+  /// docs/reference/scenario-file.md), where rows far from their bound are checked after the
+  /// solve instead of weighing on every KKT factorisation.
+  std::vector<bool> omittedTorqueRows;
+};
+
 class MotionProblem final : public NlpProblem {
  public:
-  /// `omittedTorqueRows` (empty, or one flag per joint and sample, index s · n + j) leaves
-  /// those torque-limit rows out of the NLP: torque-limit screening (formulation.md §10;
-  /// docs/reference/scenario-file.md), where rows far from their bound are checked after the solve
-  /// instead of weighing on every KKT factorisation.
-  explicit MotionProblem(const Scenario& scenario, std::vector<bool> omittedTorqueRows = {});
+  MotionProblem(const Scenario& scenario, MotionProblemOptions options);
+  /// The problem with the scenario's own Hessian model (scenario.solve.hessian) and every
+  /// torque-limit row.
+  explicit MotionProblem(const Scenario& scenario);
+  /// The Hessian model it was built with.
+  HessianOption hessianOption() const { return hessian_; }
   /// Per joint and sample (index s · n + j): whether |Γ_js| < fraction · its limit at x
   /// (joints without a finite limit: true). For torque-limit screening.
   std::vector<bool> torquesBelow(const Eigen::VectorXd& x, double fraction);
@@ -243,7 +257,7 @@ class MotionProblem final : public NlpProblem {
   void objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) override;
   void constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) override;
   void jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& values) override;
-  /// The scenario's `hessian` option: `sample-differences` assembles Σ_s B_sᵀ H_s B_s from
+  /// Its Hessian model (MotionProblemOptions::hessian): `sample-differences` assembles Σ_s B_sᵀ H_s B_s from
   /// each sample's and task instant's state-space Hessian (motion_hessian.cpp); otherwise
   /// the generic differences of whole gradients (NlpProblem).
   void lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
@@ -452,6 +466,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<bool> unusedParameter_;
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit (when limited)
+  HessianOption hessian_;
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants

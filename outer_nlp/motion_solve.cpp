@@ -14,7 +14,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
   const Scenario scenario = withStagesForItsFormulation(given);
   MotionSolveOutcome result;
   Eigen::VectorXd x = x0;
-  const int stages = static_cast<int>(scenario.continuation.size()) + 1;
+  const int stages = static_cast<int>(scenario.solve.continuation.size()) + 1;
   std::optional<Scenario> solved;  // the problem of the last stage that ended optimal
   Eigen::MatrixXd closureAngles;  // the closing joints' angles at each sample, handed from solve to solve
   for (int k = 0; k < stages; ++k) {
@@ -35,25 +35,26 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     full.startClosureAt(closureAngles);
     if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
     std::vector<bool> omitted;
-    if (scenario.torqueLimits && scenario.torqueScreening > 0.0) omitted = full.torquesBelow(x, scenario.torqueScreening);
+    const double screening = scenario.solve.torqueScreening;
+    if (scenario.torqueLimits && screening > 0.0) omitted = full.torquesBelow(x, screening);
     StageOutcome stage;
     stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
     stage.smoothing = stageScenario.smoothing;
     stage.samples = stageScenario.samples;
-    stage.hessian = stageScenario.hessian;
+    stage.hessian = stageScenario.solve.hessian;
     stage.energyForm = stageScenario.energyForm;
     OuterOutcome outcome;
     int joined = 0;
     for (;;) {
-      MotionProblem current(stageScenario, omitted);
+      MotionProblem current(stageScenario, {stageScenario.solve.hessian, omitted});
       current.startClosureAt(closureAngles);  // the closure continues the motion's branch
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
       if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
       OuterSolverSettings roundSettings = settings;
-      roundSettings.problemHessian = stageScenario.hessian != HessianOption::LimitedMemory;
+      roundSettings.problemHessian = stageScenario.solve.hessian != HessianOption::LimitedMemory;
       // After the scenario's options: the stage's own limit wins.
-      if (!last && scenario.continuation[static_cast<std::size_t>(k)].maxIterations >= 0)
-        roundSettings.maxIterations = scenario.continuation[static_cast<std::size_t>(k)].maxIterations;
+      if (!last && scenario.solve.continuation[static_cast<std::size_t>(k)].maxIterations >= 0)
+        roundSettings.maxIterations = scenario.solve.continuation[static_cast<std::size_t>(k)].maxIterations;
       // A later stage, and a screening round, starts at the iterate the last solve ended on, to
       // be kept: a small barrier parameter keeps Ipopt near it instead of re-centring it
       // (measured on the bilevel weight shift: from the Gauss–Newton stage's iterate,
@@ -90,7 +91,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       if (outcome.x.size() != x.size() || !outcome.x.allFinite() || !outcome.optimal() || omitted.empty()) break;
       // Optimal for the rows in the problem, and for all of them when every omitted row is
       // still below its fraction (then strictly inside its bound: multiplier 0).
-      const std::vector<bool> below = full.torquesBelow(outcome.x, scenario.torqueScreening);
+      const std::vector<bool> below = full.torquesBelow(outcome.x, scenario.solve.torqueScreening);
       joined = 0;
       for (std::size_t i = 0; i < omitted.size(); ++i)
         if (omitted[i] && !below[i]) omitted[i] = false, ++joined;

@@ -67,7 +67,7 @@ std::vector<std::string> MotionVerification::failures() const {
 }
 
 double scenarioConstraintTolerance(const Scenario& scenario) {
-  for (const SolverOption& o : scenario.solverOptions)
+  for (const SolverOption& o : scenario.solve.solverOptions)
     if (o.name == "constr_viol_tol") return o.type == SolverOption::Type::Integer ? o.integer : o.number;
   return 1e-4;  // Ipopt's default
 }

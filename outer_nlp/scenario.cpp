@@ -261,8 +261,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     if (l["velocity"]) s.velocityLimits = yaml::flag(file, l["velocity"], "limits.velocity");
     if (l["torque"]) s.torqueLimits = yaml::flag(file, l["torque"], "limits.torque");
     if (l["torque_screening"]) {
-      s.torqueScreening = yaml::nonNegative(file, l["torque_screening"], "limits.torque_screening");
-      if (s.torqueScreening >= 1.0)
+      s.solve.torqueScreening = yaml::nonNegative(file, l["torque_screening"], "limits.torque_screening");
+      if (s.solve.torqueScreening >= 1.0)
         throw InputError(where(file, l["torque_screening"], "limits.torque_screening") +
                          "expected a fraction of the limit in [0, 1) (0: every row in the problem)");
     }
@@ -336,16 +336,17 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     const YAML::Node init = root["initialisation"];
     yaml::rejectUnknownKeys(file, init, "initialisation", {"configuration_optimisation", "configuration_iterations"});
     if (init["configuration_optimisation"])
-      s.configurationOptimisation = yaml::flag(file, init["configuration_optimisation"], "initialisation.configuration_optimisation");
+      s.solve.configurationOptimisation =
+          yaml::flag(file, init["configuration_optimisation"], "initialisation.configuration_optimisation");
     if (init["configuration_iterations"])
-      s.configurationIterations =
+      s.solve.configurationIterations =
           yaml::integerAtLeast(file, init["configuration_iterations"], "initialisation.configuration_iterations", 1);
   }
-  if (root["refine"]) s.refineRounds = yaml::integerAtLeast(file, root["refine"], "refine", 0);
+  if (root["refine"]) s.solve.refineRounds = yaml::integerAtLeast(file, root["refine"], "refine", 0);
   if (root["hessian"]) {
     const std::string hessian = yaml::text(file, root["hessian"], "hessian");
     try {
-      s.hessian = parseHessianOption(hessian);
+      s.solve.hessian = parseHessianOption(hessian);
     } catch (const InputError& e) {
       throw InputError(where(file, root["hessian"], "hessian") + e.what());
     }
@@ -361,7 +362,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       yaml::rejectUnknownKeys(file, stage, field,
                               {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy",
                                "for_contact_forces"});
-      Scenario::ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.hessian, -1, s.energyForm, {}};
+      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}};
       if (stage["energy"]) {
         const std::string form = yaml::text(file, stage["energy"], field + ".energy");
         if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
@@ -417,19 +418,19 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                            "cannot change the samples");
         c.samples = yaml::integerAtLeast(file, stage["samples"], field + ".samples", 2);
       }
-      s.continuation.push_back(c);
+      s.solve.continuation.push_back(c);
     }
   }
 
   if (root["solver"]) readSolverOptions(file, root["solver"], s);
   if (s.ball) checkThrowTask(file, throwNode, throwField, s);
-  if (s.hessian == HessianOption::Exact)
+  if (s.solve.hessian == HessianOption::Exact)
     if (const std::string why = exactHessianRefusal(s); !why.empty())
       throw InputError(where(file, root["hessian"], "hessian") + "exact: " + why);
   // Only the stages that run, with the run's formulation (the file's, or `contactForces`
   // from `mcopt run --contact-forces`): a stage for `splines` alone is no bilevel run's.
-  for (std::size_t k = 0; k < s.continuation.size(); ++k)
-    if (s.continuation[k].hessian == HessianOption::Exact && s.continuation[k].runsWith(s.contactForces))
+  for (std::size_t k = 0; k < s.solve.continuation.size(); ++k)
+    if (s.solve.continuation[k].hessian == HessianOption::Exact && s.solve.continuation[k].runsWith(s.contactForces))
       if (const std::string why = exactHessianRefusal(continuationStage(s, k)); !why.empty()) {
         const std::string field = "continuation[" + std::to_string(k) + "]";
         const YAML::Node stage = root["continuation"][k];

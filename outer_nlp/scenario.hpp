@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #pragma once
-// A motion-optimisation scenario (docs/reference/scenario-file.md): the robot and its side files, the
-// reference body, the contacts, the duration and samples, the objective, the limits, the
-// tasks, the initialisation and Ipopt's options (formulation.md §10). loadScenario
-// validates everything and names file, line and field in every error.
+// A motion-optimisation scenario (docs/reference/scenario-file.md): the problem — the robot and
+// its side files, the reference body, the contacts, the duration and samples, the objective,
+// the limits, the tasks, the start and end postures (formulation.md §10) — and how it is
+// solved (Scenario::solve, solve_settings.hpp). loadScenario validates everything and names
+// file, line and field in every error.
 
 #include <Eigen/Core>
 #include <algorithm>
@@ -19,15 +20,11 @@
 #include "core/robot_files.hpp"
 #include "core/robot_model.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
+#include "outer_nlp/solve_settings.hpp"
 #include "outer_nlp/task.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
 
 namespace mcopt {
-
-enum class EnergyForm {
-  SmoothMaximum,  ///< P⁺ ≈ (P + sqrt(P² + ε²)) / 2 (formulation.md §6)
-  Epigraph,       ///< slack s ≥ P, s ≥ 0 per joint and sample; minimise the trapezoid sum of s
-};
 
 /// A task of the scenario: what it bounds (a Task, outer_nlp/task.hpp), where it came from,
 /// when it holds, and its bounds; ±∞ where a component is free.
@@ -59,37 +56,6 @@ struct ThrownBall {
   double gravity = 9.81;             ///< gravity's magnitude (along −z) [m/s²]
 };
 
-/// What Ipopt's Newton steps use as the Lagrangian's Hessian (docs/theory/outer-problem.md, "Hessian
-/// and convergence").
-enum class HessianOption {
-  LimitedMemory,      ///< Ipopt's quasi-Newton (L-BFGS) approximation, as the report
-  FiniteDifferences,  ///< forward differences of the exact gradient, one whole evaluation per variable
-  SampleDifferences,  ///< Σ_s B_sᵀ H_s B_s, H_s by differences of each sample's exact gradient in its state
-  /// The same with each H_s (and each task instant's) projected onto the positive
-  /// semidefinite cone (negative eigenvalues set to zero): a convex model, no inertia correction.
-  ConvexSampleDifferences,
-  /// Σ_s B_sᵀ H_s B_s with H_s assembled from each sample's exact first derivatives (no
-  /// extra evaluation): the exact curvature of the energy and epigraph terms in the sample's
-  /// outputs (P in Γ, q̇, q̈; the smooth maximum in P) chained through the outputs' exact
-  /// Jacobian, the outputs' own curvature (∇²Γ, of the dynamics and the inner optimum)
-  /// left out — a Gauss–Newton model. Task instants as sample-differences.
-  GaussNewton,
-  /// The Lagrangian's Hessian itself: each H_s is the gauss-newton terms plus the outputs' own
-  /// curvature Σ_o w_o ∇²y_o, differentiated along each state component by a stencil that is
-  /// exact on how the dynamics depend on it (polynomial in q̇, q̈ and the force variables,
-  /// trigonometric in a revolute joint's angle: outer_nlp/derivative_stencil.hpp); task
-  /// instants the same; the duration's row and column by the chain rule. Exact up to
-  /// rounding. Not for what is not of that form (exactHessianRefusal).
-  Exact,
-};
-const char* toString(HessianOption hessian);
-/// "limited-memory", "finite-differences", "sample-differences", "convex-sample-differences",
-/// "gauss-newton" or "exact";
-/// throws InputError otherwise.
-HessianOption parseHessianOption(const std::string& name);
-/// Every option's name, in the order above (the choices of `mcopt run --hessian`).
-const std::vector<std::string>& hessianOptionNames();
-
 /// A contact other than the reference body's: its surface is fixed in the world over the
 /// whole motion or over a window, at a given world pose or the one it has in the start
 /// posture (formulation.md §10).
@@ -106,14 +72,6 @@ struct DurationSpec {
   double initial = 1.0;  ///< [s]
   double lower = 1.0, upper = 1.0;
   bool free() const { return lower < upper; }
-};
-
-/// An Ipopt option as written in the scenario (type decided by the YAML scalar).
-struct SolverOption {
-  enum class Type { Integer, Number, Text } type = Type::Text;
-  std::string name, text, origin;
-  double number = 0.0;
-  int integer = 0;
 };
 
 struct Scenario {
@@ -152,10 +110,6 @@ struct Scenario {
   double accelerationWeight = 0.0; ///< w of the regularisation w ∫ Σ_j q̈_j² dt [J s⁴/rad²/s]
 
   bool positionLimits = true, velocityLimits = true, torqueLimits = true;
-  /// Torque-limit rows whose |Γ| stays below this fraction of the limit are left out of the
-  /// NLP and checked after the solve; rows that reach it join and the problem is solved
-  /// again (docs/theory/outer-problem.md, "Torque-limit screening"). 0: every row in the NLP.
-  double torqueScreening = 0.5;
   std::vector<TaskSpec> tasks;
   /// A throw task's ball (at most one throw a scenario); its two rows are in `tasks`.
   std::optional<ThrownBall> ball;
@@ -165,8 +119,6 @@ struct Scenario {
   /// `end: {same_as: start}`: one posture for both ends (MotionParametrization's periodic
   /// layout), so the motion returns exactly to where it started; end = start, fixEnd = fixStart.
   bool periodic = false;
-  bool configurationOptimisation = true;
-  int configurationIterations = 500;
   /// A given initial motion instead of the interpolation from start to end (`mcopt run
   /// --start-from`, outer_nlp/scenario_run.hpp `startFromMotion`).
   struct InitialMotion {
@@ -175,48 +127,15 @@ struct Scenario {
   };
   std::optional<InitialMotion> initialMotion;
 
-  /// Refinement rounds after the optimum (`refine`, `mcopt run --refine`; scenario_run.hpp
-  /// refineRun): while its motion does not verify between the samples, solve again on twice the
-  /// sample intervals. 0: none.
-  int refineRounds = 0;
-
-  std::vector<SolverOption> solverOptions;
-  HessianOption hessian = HessianOption::SampleDifferences;  ///< the best measured (docs/theory/outer-problem.md)
-
-  /// Problems solved before this one, each from the previous one's result (the first from
-  /// the initial motion), with a smoother friction model and/or smooth maximum: the dry
-  /// friction's steep atan(ν N q̇) makes the kick's Lagrangian indefinite at every joint that
-  /// is nearly still, and Newton's steps need hundreds of iterations there
-  /// (docs/theory/outer-problem.md, "Hessian options"). The scenario's own problem is solved last.
-  struct ContinuationStage {
-    double frictionSharpness = 0.0;  ///< ν [s/rad]
-    double smoothing = 0.0;          ///< ε [W]
-    int samples = 0;                 ///< N: a coarser grid, the same spline parameters
-    HessianOption hessian = HessianOption::SampleDifferences;  ///< the scenario's unless the stage names one
-    int maxIterations = -1;          ///< Ipopt's max_iter for the stage; -1: the scenario's
-    /// The stage's energy form: a smooth-maximum stage before the exact epigraph form, whose
-    /// slack variables the next stage sets at max(P, 0) of the motion reached (MotionProblem::
-    /// pointFrom; docs/theory/outer-problem.md, "Continuation").
-    EnergyForm energyForm = EnergyForm::SmoothMaximum;
-    /// The contact-force formulations the stage runs with (`for_contact_forces`); empty: every
-    /// one. A hand-over stage that helps one formulation may hinder another (measured on the
-    /// weight shift: Gauss–Newton first makes the bilevel run converge in seconds and keeps the
-    /// `variables` one from converging; docs/theory/outer-problem.md, "Multi-contact"), and
-    /// `mcopt run --contact-forces` chooses the formulation after the file is read.
-    std::vector<std::string> forContactForces;
-    /// Whether the stage runs with that formulation.
-    bool runsWith(const std::string& forces) const {
-      return forContactForces.empty() ||
-             std::find(forContactForces.begin(), forContactForces.end(), forces) != forContactForces.end();
-    }
-  };
-  std::vector<ContinuationStage> continuation;
+  /// How the problem above is solved: Hessian model, continuation, screening, configuration
+  /// optimisation, refinement, the outer solver's options (solve_settings.hpp).
+  SolveSettings solve;
 };
 
 /// The scenario with only the continuation stages that run with its contact-force
 /// formulation (ContinuationStage::forContactForces), in their order.
 Scenario withStagesForItsFormulation(const Scenario& scenario);
-/// Stage k of the scenario's continuation (k = continuation.size(): the scenario itself):
+/// Stage k of the scenario's continuation (k = solve.continuation.size(): the scenario itself):
 /// a copy with that stage's friction sharpness, smoothing, samples and Hessian option.
 Scenario continuationStage(const Scenario& scenario, std::size_t k);
 /// Whether a stage (continuationStage's copy) poses the scenario's own problem: the same ν, ε,

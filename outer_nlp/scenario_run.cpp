@@ -34,7 +34,7 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
   outcome.optimised = true;
   outcome.staticPowerBefore = problem.staticPower(guess);
   OuterSolverSettings settings;
-  settings.maxIterations = scenario.configurationIterations;  // initialisation.configuration_iterations
+  settings.maxIterations = scenario.solve.configurationIterations;  // initialisation.configuration_iterations
   const OuterOutcome result = solveOuter(problem, guess, settings, [&](const IterationReport&) {
     return !events.keepRunning || events.keepRunning();
   });
@@ -50,16 +50,16 @@ Eigen::VectorXd optimisePosture(const Scenario& scenario, const MotionProblem& m
 /// from the scenario) in nothing but its iteration limit would solve the same problem again,
 /// so it goes and the next one solves it.
 void overrideHessian(Scenario& scenario, HessianOption hessian) {
-  scenario.hessian = hessian;
-  std::vector<Scenario::ContinuationStage> kept;
-  for (std::size_t k = 0; k < scenario.continuation.size(); ++k)
+  scenario.solve.hessian = hessian;
+  std::vector<ContinuationStage> kept;
+  for (std::size_t k = 0; k < scenario.solve.continuation.size(); ++k)
     if (!posesScenarioProblem(continuationStage(scenario, k), continuationStage(scenario, k + 1))) {
-      kept.push_back(scenario.continuation[k]);
+      kept.push_back(scenario.solve.continuation[k]);
       kept.back().hessian = hessian;
     }
-  scenario.continuation = std::move(kept);
+  scenario.solve.continuation = std::move(kept);
   if (hessian != HessianOption::Exact) return;
-  for (std::size_t k = 0; k <= scenario.continuation.size(); ++k)
+  for (std::size_t k = 0; k <= scenario.solve.continuation.size(); ++k)
     if (const std::string why = exactHessianRefusal(continuationStage(scenario, k)); !why.empty())
       throw InputError("--hessian: exact: " + why);
 }
@@ -71,7 +71,7 @@ std::string postureWarning(const std::string& which, const PostureOutcome& p, co
   what << "configuration optimisation of the " << which << " posture ended " << toString(p.status) << " after "
        << p.iterations << " iterations";
   if (p.status == OuterStatus::MaximumIterations)
-    what << " (its cap, initialisation.configuration_iterations: " << scenario.configurationIterations << ")";
+    what << " (its cap, initialisation.configuration_iterations: " << scenario.solve.configurationIterations << ")";
   what << ", static power " << p.staticPowerBefore << " → " << p.staticPowerAfter
        << " W: the motion starts from a posture that is not the static optimum";
   return what.str();
@@ -80,11 +80,11 @@ std::string postureWarning(const std::string& which, const PostureOutcome& p, co
 }  // namespace
 
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
-  if (o.configurationOptimisation) scenario.configurationOptimisation = *o.configurationOptimisation;
+  if (o.configurationOptimisation) scenario.solve.configurationOptimisation = *o.configurationOptimisation;
   if (o.contactForces) scenario.contactForces = *o.contactForces;
   if (o.refineRounds) {
     if (*o.refineRounds < 0) throw InputError("refine: expected a number of rounds ≥ 0, got " + std::to_string(*o.refineRounds));
-    scenario.refineRounds = *o.refineRounds;
+    scenario.solve.refineRounds = *o.refineRounds;
   }
   if (o.innerSolver) {
     if (!isInnerSolverName(*o.innerSolver))
@@ -98,9 +98,9 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
     SolverOption limit;
     limit.name = "max_iter", limit.type = SolverOption::Type::Integer, limit.integer = *o.maxIterations;
     limit.origin = "--max-iterations: ";
-    scenario.solverOptions.push_back(limit);
+    scenario.solve.solverOptions.push_back(limit);
     // Every continuation stage too: the override bounds the whole run's work, stage by stage.
-    for (Scenario::ContinuationStage& stage : scenario.continuation)
+    for (ContinuationStage& stage : scenario.solve.continuation)
       stage.maxIterations = stage.maxIterations < 0 ? *o.maxIterations : std::min(stage.maxIterations, *o.maxIterations);
   }
 }
@@ -141,7 +141,7 @@ void startFromMotion(Scenario& scenario, const std::map<std::string, std::vector
   }
   motion.duration = std::clamp(duration, T.lower, T.upper);
   for (int j = 0; j < n; ++j) scenario.start[j] = motion.parameters[j * m], scenario.end[j] = motion.parameters[j * m + endParameter];
-  scenario.configurationOptimisation = false;
+  scenario.solve.configurationOptimisation = false;
   scenario.initialMotion = std::move(motion);
 }
 
@@ -182,7 +182,7 @@ RunRecord runScenario(const Scenario& scenario, MotionProblem& problem, const Sc
       record.warnings.push_back(check.message() + ": no motion of this problem reaches it (give the task more time or a nearer target)");
   if (events.onTimingChecks) events.onTimingChecks(record.timingChecks);
   Eigen::VectorXd start = scenario.start, end = scenario.end;
-  if (scenario.configurationOptimisation) {
+  if (scenario.solve.configurationOptimisation) {
     if (!scenario.fixStart) {
       start = optimisePosture(scenario, problem, start, 0.0, events, record.start);
       if (const std::string w = postureWarning("start", record.start, scenario); !w.empty()) record.warnings.push_back(w);
@@ -216,8 +216,8 @@ void solveScenarioFrom(const Scenario& scenario, MotionProblem& problem, const E
   const auto clock = std::chrono::steady_clock::now();
   const double before = record.totalSeconds;  // what the record already holds (a refinement's earlier rounds)
   OuterSolverSettings settings;
-  settings.options = scenario.solverOptions;
-  settings.problemHessian = scenario.hessian != HessianOption::LimitedMemory;
+  settings.options = scenario.solve.solverOptions;
+  settings.problemHessian = scenario.solve.hessian != HessianOption::LimitedMemory;
   const auto optimisationClock = std::chrono::steady_clock::now();
   MotionSolveEvents solveEvents;
   solveEvents.onSolve = events.onSolve;
@@ -254,8 +254,8 @@ Scenario refinedScenario(const Scenario& scenario, const Eigen::VectorXd& parame
   // The fine grid of two instants an interval (every sample kept, a throw's release where the
   // coarser grid had it, no continuation), with the scenario's own torque-limit screening.
   Scenario refined = fineGridScenario(scenario, 2);
-  refined.torqueScreening = scenario.torqueScreening;
-  refined.configurationOptimisation = false;
+  refined.solve.torqueScreening = scenario.solve.torqueScreening;
+  refined.solve.configurationOptimisation = false;
   refined.initialMotion = Scenario::InitialMotion{parameters, duration};
   return refined;
 }

@@ -38,7 +38,7 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
         o.number = asDouble;
       }
     }
-    s.solverOptions.push_back(o);
+    s.solve.solverOptions.push_back(o);
   }
 }
 
@@ -133,21 +133,21 @@ std::string exactHessianRefusal(const Scenario& s) {
 
 Scenario withStagesForItsFormulation(const Scenario& scenario) {
   Scenario kept = scenario;
-  kept.continuation.clear();
-  for (const Scenario::ContinuationStage& stage : scenario.continuation)
-    if (stage.runsWith(scenario.contactForces)) kept.continuation.push_back(stage);
+  kept.solve.continuation.clear();
+  for (const ContinuationStage& stage : scenario.solve.continuation)
+    if (stage.runsWith(scenario.contactForces)) kept.solve.continuation.push_back(stage);
   return kept;
 }
 
 Scenario continuationStage(const Scenario& scenario, std::size_t k) {
   Scenario stage = scenario;
-  stage.continuation.clear();
-  if (k < scenario.continuation.size()) {
-    stage.actuators.frictionSharpness = scenario.continuation[k].frictionSharpness;
-    stage.smoothing = scenario.continuation[k].smoothing;
-    stage.samples = scenario.continuation[k].samples;
-    stage.hessian = scenario.continuation[k].hessian;
-    stage.energyForm = scenario.continuation[k].energyForm;
+  stage.solve.continuation.clear();
+  if (k < scenario.solve.continuation.size()) {
+    stage.actuators.frictionSharpness = scenario.solve.continuation[k].frictionSharpness;
+    stage.smoothing = scenario.solve.continuation[k].smoothing;
+    stage.samples = scenario.solve.continuation[k].samples;
+    stage.solve.hessian = scenario.solve.continuation[k].hessian;
+    stage.energyForm = scenario.solve.continuation[k].energyForm;
   }
   return stage;
 }

@@ -130,7 +130,7 @@ void checkThrowTask(const std::filesystem::path& file, const YAML::Node& node, c
                        c.surface.name + "'");
   // The payload changes the dynamics at the release: the two torques there are a sample's.
   std::vector<int> grids{s.samples};
-  for (const Scenario::ContinuationStage& c : s.continuation) grids.push_back(c.samples);
+  for (const ContinuationStage& c : s.solve.continuation) grids.push_back(c.samples);
   for (const int N : grids) {
     const double k = ball.releaseTime / s.duration.initial * (N - 1);
     if (std::abs(k - std::round(k)) > 1e-9 * (N - 1)) {

@@ -187,8 +187,8 @@ py::dict run(const ScenarioHandle& s, const py::object& progress, const std::opt
     py::gil_scoped_release release;
     const std::lock_guard<std::mutex> oneIpoptAtATime(ipoptMutex());
     record = runScenario(scenario, problem, events);
-    if (scenario.refineRounds > 0 && record.status == OuterStatus::Optimal && !failure) {
-      refined = refineRun(scenario, problem, std::move(record), scenario.refineRounds, VerificationSettings{}, events);
+    if (scenario.solve.refineRounds > 0 && record.status == OuterStatus::Optimal && !failure) {
+      refined = refineRun(scenario, problem, std::move(record), scenario.solve.refineRounds, VerificationSettings{}, events);
       record = std::move(refined->record);
     }
   }

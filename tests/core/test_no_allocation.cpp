@@ -342,7 +342,7 @@ TEST_CASE("the outer problem's evaluation allocates nothing once warm: one conta
       Scenario scenario = loadScenario(test::sourceDir() / "scenarios" / file);
       scenario.samples = scenario.ball ? 21 : 20;
       scenario.contactForces = forces;
-      scenario.hessian = option;
+      scenario.solve.hessian = option;
       if (option == HessianOption::Exact && !exactHessianRefusal(scenario).empty()) continue;  // a throw, bilevel with contacts
       MotionProblem problem(scenario);
       Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end), gradient, constraints, jacobian, hessian;

@@ -263,7 +263,7 @@ TEST_CASE("closed chains: a loop that cannot be closed is refused, naming the co
   // The exact Hessian option has no stencil for the closure's map.
   Scenario exact = weightShift();
   exact.contactForces = "splines";
-  exact.hessian = HessianOption::Exact;
+  exact.solve.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(exact), Catch::Contains("contact 'r_sole' is held by construction"));
 }
 

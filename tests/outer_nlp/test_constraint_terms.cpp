@@ -32,7 +32,7 @@ struct Variant {
 std::vector<Variant> variants() {
   std::vector<Variant> out;
   Scenario kick = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
-  kick.samples = 12, kick.energyForm = EnergyForm::Epigraph, kick.torqueScreening = 0.0;
+  kick.samples = 12, kick.energyForm = EnergyForm::Epigraph, kick.solve.torqueScreening = 0.0;
   out.push_back({"kick, epigraph", kick});
   Scenario lean = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
   lean.samples = 12;
@@ -161,7 +161,7 @@ TEST_CASE("cost terms: each energy form's objective is the sampled energy, and t
   // Against the motion's own samples (sampledPhysics: P and q̈ at each sample, max(P, 0)
   // integrated by the trapezoid rule), not against the terms' code.
   Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
-  s.samples = 15, s.torqueScreening = 0.0;
+  s.samples = 15, s.solve.torqueScreening = 0.0;
   const auto integrate = [](const MotionProblem& problem, double T, const auto& integrand) {
     double sum = 0.0;
     for (int k = 0; k < problem.sampleCount(); ++k) sum += problem.sampleWeight(k) * T * integrand(k);

@@ -105,7 +105,7 @@ Scenario kick(int samples) {
   s.smoothing = 0.01;
   s.samples = samples;
   s.outputSamples = 20;
-  s.hessian = HessianOption::SampleDifferences;
+  s.solve.hessian = HessianOption::SampleDifferences;
   return s;
 }
 
@@ -196,7 +196,7 @@ TEST_CASE("gauss-newton Hessian: equal to its independent assembly from the Jaco
     // entries differ from the independent assembly by 3e-7 relative (lab-notes/contacts-that-hold.md).
     if (c.bilevel) s.controlPoints = 11;
     s.outputSamples = 20;
-    s.hessian = HessianOption::GaussNewton;
+    s.solve.hessian = HessianOption::GaussNewton;
     if (c.bilevel) s.contactForces = "bilevel";
     if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
     if (!c.bilevel && !c.epigraph) s.accelerationWeight = 1e-3;
@@ -271,7 +271,7 @@ TEST_CASE("sample-differences Hessian: every contact-force formulation", "[outer
     s.outputSamples = 20;
     s.forceControlPoints = 6;
     s.contactForces = forces;
-    s.hessian = HessianOption::SampleDifferences;
+    s.solve.hessian = HessianOption::SampleDifferences;
     MotionProblem problem(s);
     const Eigen::VectorXd x = test::perturbedMotion(problem, 0.02, 11);
     double generic = 0.0;
@@ -322,7 +322,7 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
     if (s.ball) {
       // The release (0.6 of the motion) on a sample; every optional row of the throw bounded.
       s.samples = 11;
-      s.continuation.clear();
+      s.solve.continuation.clear();
       for (TaskSpec& t : s.tasks) {
         if (t.task->kind() == "throw_landing") t.lower[2] = 0.1, t.upper[2] = 3.0;  // flight time [s]
         if (t.task->kind() == "throw_release") t.lower.head<2>() << 0.5, -1.0, t.upper.head<2>() << 20.0, 1.4;
@@ -331,7 +331,7 @@ TEST_CASE("exact Hessian: the Lagrangian's Hessian, against extrapolated differe
     s.outputSamples = 20;
     s.forceControlPoints = 6;
     s.contactForces = c.forces;
-    s.hessian = HessianOption::Exact;
+    s.solve.hessian = HessianOption::Exact;
     s.inner.problem.model = makeContactModel(c.model);
     s.accelerationWeight = c.accelerationWeight;
     if (c.epigraph) s.energyForm = EnergyForm::Epigraph;
@@ -356,7 +356,7 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   // in the state (a command-line override meets the problem's own check).
   Scenario lean = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
   lean.contactForces = "bilevel";
-  lean.hessian = HessianOption::Exact;
+  lean.solve.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(lean), Catch::Matchers::Contains("hessian: exact: the bilevel formulation"));
   // In the file and in a continuation stage (the bundled throw is bilevel on two soles):
   // file:line: field: why.
@@ -408,7 +408,7 @@ TEST_CASE("exact Hessian: refused where its stencils do not hold, with the file'
   Scenario kickEpigraph = kick(8);
   kickEpigraph.energyForm = EnergyForm::Epigraph;
   kickEpigraph.duration.lower = 1.2, kickEpigraph.duration.upper = 2.0;
-  kickEpigraph.hessian = HessianOption::Exact;
+  kickEpigraph.solve.hessian = HessianOption::Exact;
   CHECK_THROWS_WITH(MotionProblem(kickEpigraph), Catch::Matchers::Contains("epigraph form with a free duration"));
 }
 
@@ -425,7 +425,7 @@ TEST_CASE("exact Hessian: entry by entry where differences can tell, on a smooth
   Scenario s = kick(16);
   s.actuators.frictionSharpness = 0.01;
   s.smoothing = 1.0;
-  s.hessian = HessianOption::Exact;
+  s.solve.hessian = HessianOption::Exact;
   MotionProblem problem(s);
   const Eigen::VectorXd x = test::perturbedMotion(problem, 0.05, 23);
   const int curved = problem.nonlinearVariableCount();

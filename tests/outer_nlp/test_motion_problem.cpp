@@ -48,7 +48,7 @@ TEST_CASE("outer problem: exact gradient and sparse Jacobian agree with central 
   // section's. The bundled kick is periodic (end: {same_as: start}); a section takes the free
   // ends. Its exact Hessian refuses a free duration with the epigraph form: the Hessian option
   // does not enter these first derivatives.
-  scenario.hessian = HessianOption::SampleDifferences;
+  scenario.solve.hessian = HessianOption::SampleDifferences;
   scenario.energyForm = EnergyForm::SmoothMaximum;
   scenario.smoothing = 0.01;
 #ifdef MCOPT_UNDER_SANITIZERS
@@ -102,7 +102,7 @@ TEST_CASE("outer problem: exact gradient and sparse Jacobian agree with central 
 
 TEST_CASE("outer problem: every task kind has exact derivatives", "[outer]") {
   Scenario scenario = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
-  scenario.hessian = HessianOption::SampleDifferences;  // the exact one refuses the epigraph with a free T
+  scenario.solve.hessian = HessianOption::SampleDifferences;  // the exact one refuses the epigraph with a free T
   scenario.samples = 20;
   scenario.duration.lower = 1.0, scenario.duration.upper = 2.5;  // free T: the instants scale with it
   scenario.tasks = test::everyTaskKind(scenario);

@@ -24,8 +24,8 @@ Scenario coarseKick() {
   Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
   s.samples = 12;
   s.outputSamples = 20;
-  s.torqueScreening = 0.0;
-  s.continuation.clear();
+  s.solve.torqueScreening = 0.0;
+  s.solve.continuation.clear();
   return s;
 }
 
@@ -152,8 +152,8 @@ TEST_CASE("refine: a round's grid halves every interval, keeps every sample and 
   const Eigen::VectorXd x = coarse.initialPoint(s.start, s.end);
   const Scenario refined = refinedScenario(s, coarse.motionParameters(x), coarse.duration(x));
   CHECK(refined.samples == 21);
-  CHECK(refined.continuation.empty());
-  CHECK_FALSE(refined.configurationOptimisation);
+  CHECK(refined.solve.continuation.empty());
+  CHECK_FALSE(refined.solve.configurationOptimisation);
   REQUIRE(refined.initialMotion);
   MotionProblem fine(refined);
   const SampledPhysics a = coarse.sampledPhysics(x), b = fine.sampledPhysics(fine.pointWithWrenchesFrom(coarse, x));

@@ -29,7 +29,7 @@ Scenario throwScenario(int samples) {
   Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_throw.yaml");
   s.samples = samples;
   s.outputSamples = 20;
-  s.continuation.clear();
+  s.solve.continuation.clear();
   return s;
 }
 

@@ -40,7 +40,7 @@ TEST_CASE("torque-limit screening: the screened problem is the full one without 
   REQUIRE(omitted > 0);
   REQUIRE(kept > 0);  // both kinds present: the check means something
 
-  MotionProblem screened(s, below);
+  MotionProblem screened(s, {s.solve.hessian, below});
   CHECK(screened.omittedTorqueRowCount() == omitted);
   REQUIRE(screened.constraintCount() == full.constraintCount() - omitted);
   CHECK(screened.variableCount() == full.variableCount());
@@ -83,7 +83,7 @@ TEST_CASE("torque-limit screening: the screened problem is the full one without 
   }
   CHECK(torqueRows == kept);
 
-  CHECK_THROWS_AS(MotionProblem(s, std::vector<bool>(7, true)), InputError);
+  CHECK_THROWS_AS(MotionProblem(s, {s.solve.hessian, std::vector<bool>(7, true)}), InputError);
 }
 
 }  // namespace mcopt
