@@ -15,6 +15,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -183,6 +184,7 @@ int runMotion(const RunOptions& o) {
               << (solve.problem.bilevel() ? "   infeasible samples" : "") << (scenario.ball ? "   miss [m]" : "") << "\n";
     lastCheckpoint = 0.0;
   };
+  std::unique_ptr<MotionProblem> checkpointProblem;
   events.onIteration = [&](const RunRecord& sofar, const MotionProblem& current, const IterationReport& r) {
     std::printf("  %5d  %14.6f  %10.3e  %10.3e  %8.2f s", r.iteration, r.objective, r.violation, r.dualInfeasibility,
                 r.elapsedSeconds);
@@ -193,7 +195,12 @@ int runMotion(const RunOptions& o) {
     std::fflush(stdout);
     if (o.checkpointSeconds >= 0 && r.iterate != nullptr && r.iteration > 0 &&
         r.elapsedSeconds - lastCheckpoint >= o.checkpointSeconds) {
-      writeCheckpoint(o.out, problem, sofar, r, sofar.optimisationSeconds, sofar.totalSeconds);
+      // On a problem of its own: a bilevel sample's inner answer is warm-started from its last
+      // one, so evaluating the run's problem at the checkpoints — when the clock says, at
+      // iterates that depend on the machine's speed — would change the last bits of the
+      // result's torques and wrenches (docs/developers/determinism.md).
+      if (!checkpointProblem) checkpointProblem = std::make_unique<MotionProblem>(scenario);
+      writeCheckpoint(o.out, *checkpointProblem, sofar, r, sofar.optimisationSeconds, sofar.totalSeconds);
       lastCheckpoint = r.elapsedSeconds;
     }
     return true;

@@ -90,6 +90,32 @@ TEST_CASE("determinism: the bilevel weight shift, inner solves warm-started, wit
   sameWithAnyThreads(dir, scenario, "--contact-forces bilevel --inner-solver active-set --max-iterations 3 --checkpoint-seconds -1");
 }
 
+// A checkpoint (--checkpoint-seconds) writes the current iterate's run files. It used to
+// evaluate the run's own problem, whose bilevel samples then started their next solves from the
+// checkpoint's answers: the result's torques and wrenches differed in their last bits with when
+// the clock had called for a checkpoint — with the thread count, the machine, the load.
+TEST_CASE("determinism: checkpoints after every iteration leave the result as no checkpoint does", "[cli][determinism]") {
+  const test::TempDir dir;
+  const auto scenario = test::scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    if (kUnderSanitizers) root["samples"] = 8;
+  }, "weight_shift.yaml");
+  std::vector<Json> results;
+  for (const char* every : {"0", "-1"}) {
+    const auto out = dir.path() / (std::string("checkpoints") + every);
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out) +
+                                      " --max-iterations 10 --checkpoint-seconds " + every,
+                                  "OMP_NUM_THREADS=2");
+    INFO(r.all());
+    REQUIRE((r.exitCode == 0 || r.exitCode == 4));
+    results.push_back(withoutClocks(out));
+  }
+  CHECK(results[0]["solver"]["iterations"].get<int>() > 0);
+  for (const auto& [key, value] : results[0].items()) {
+    INFO("result.json field " << key);
+    CHECK(value == results[1][key]);
+  }
+}
+
 // While InnerNlp left the elastic phase's band rows unwritten, SLSQP read whatever its
 // constraint buffer held, and this run's 12th iteration differed in the seventh digit with
 // the output folder's name (docs/theory/inner-problem.md, "Determinism").
