@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "core/errors.hpp"
+#include "core/registry.hpp"
 
 namespace mcopt {
 
@@ -79,11 +80,7 @@ const std::vector<ContactModelEntry>& contactModels() {
 }
 
 const std::vector<std::string>& contactModelNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const ContactModelEntry& e : contactModels()) out.push_back(e.name);
-    return out;
-  }();
+  static const std::vector<std::string> names = registryNames(contactModels());
   return names;
 }
 
@@ -95,8 +92,7 @@ bool isContactModelName(const std::string& name) {
 std::string contactModelList() { return alternatives(contactModelNames()); }
 
 std::shared_ptr<const ContactModel> makeContactModel(const std::string& name, const ContactModelOptions& options) {
-  for (const ContactModelEntry& e : contactModels())
-    if (e.name == name) return e.make(options);
+  if (const ContactModelEntry* e = findInRegistry(contactModels(), name)) return e->make(options);
   throw InputError("contact model: expected " + contactModelList() + "; got '" + name + "'");
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/errors.hpp"
+#include "core/registry.hpp"
 #include "inner_qp/dual_active_set_qp.hpp"
 #include "inner_qp/answer_polishing.hpp"
 #include "inner_qp/inner_nlp.hpp"
@@ -42,11 +43,7 @@ const std::vector<InnerSolverEntry>& innerSolvers() {
 }
 
 const std::vector<std::string>& innerSolverNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const InnerSolverEntry& e : innerSolvers()) out.push_back(e.name);
-    return out;
-  }();
+  static const std::vector<std::string> names = registryNames(innerSolvers());
   return names;
 }
 
@@ -58,8 +55,7 @@ bool isInnerSolverName(const std::string& name) {
 std::string innerSolverList() { return alternatives(innerSolverNames()); }
 
 std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const InnerSettings& settings) {
-  for (const InnerSolverEntry& e : innerSolvers())
-    if (e.name == name) return e.make(settings);
+  if (const InnerSolverEntry* e = findInRegistry(innerSolvers(), name)) return e->make(settings);
   throw InputError("solver: expected " + innerSolverList() + "; got '" + name + "'");
 }
 

@@ -2,6 +2,7 @@
 #include "outer_nlp/formulation_registry.hpp"
 
 #include "core/errors.hpp"
+#include "core/registry.hpp"
 
 namespace mcopt {
 
@@ -23,17 +24,12 @@ const std::vector<ContactForceFormulationEntry>& contactForceFormulations() {
 }
 
 const std::vector<std::string>& contactForcesNames() {
-  static const std::vector<std::string> names = [] {
-    std::vector<std::string> out;
-    for (const ContactForceFormulationEntry& e : contactForceFormulations()) out.push_back(e.name);
-    return out;
-  }();
+  static const std::vector<std::string> names = registryNames(contactForceFormulations());
   return names;
 }
 
 const ContactForceFormulationEntry& contactForceFormulation(const std::string& name) {
-  for (const ContactForceFormulationEntry& e : contactForceFormulations())
-    if (e.name == name) return e;
+  if (const ContactForceFormulationEntry* e = findInRegistry(contactForceFormulations(), name)) return *e;
   throw InputError("unknown contact-force formulation '" + name + "' (expected " + alternatives(contactForcesNames()) + ")");
 }
 
