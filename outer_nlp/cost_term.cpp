@@ -9,9 +9,13 @@ namespace mcopt {
 // integrand sums them in this order.
 CostTerms makeCostTerms(const CostContext& context) {
   CostTerms terms;
-  terms.push_back(context.scenario.energyForm == EnergyForm::Epigraph ? makeEpigraphEnergy(context)
-                                                                       : makeSmoothMaximumEnergy(context));
-  terms.push_back(makeAccelerationRegularisation(context));
+  CostContext next = context;
+  const auto add = [&](std::unique_ptr<const CostTerm> term) {
+    next.firstVariable += term->variablesPerSample() * next.samples.sampleCount();
+    terms.push_back(std::move(term));
+  };
+  add(context.scenario.energyForm == EnergyForm::Epigraph ? makeEpigraphEnergy(next) : makeSmoothMaximumEnergy(next));
+  add(makeAccelerationRegularisation(next));
   return terms;
 }
 

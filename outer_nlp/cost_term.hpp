@@ -37,7 +37,10 @@ struct CostContext {
   const ClosedChains* closure;  ///< null without environment contacts
   const MotionParametrization& parametrization;
   const SampledTrajectory& samples;
-  int slackStart;  ///< the epigraph form's first slack: sample s, joint j at slackStart + s n + j
+  /// The first of the term's own variables (CostTerm::variablesPerSample), sample by sample:
+  /// sample s's at firstVariable + s · variablesPerSample. makeCostTerms lays the terms' variables
+  /// out one after the other, in the registry's order, after every other variable.
+  int firstVariable;
 };
 
 /// One sample as a cost term sees it: its outputs and state, and (after an evaluation with
@@ -74,11 +77,21 @@ class CostTerm {
   virtual void addStateGradient(const CostSample& /*sample*/, double /*weight*/, Eigen::Ref<Eigen::VectorXd> /*gradient*/) const {}
   /// Into the lower triangle of H (3n + force columns square).
   virtual void addStateHessian(const CostSample& /*sample*/, double /*weight*/, Eigen::Ref<Eigen::MatrixXd> /*H*/) const {}
+
+  // Variables of its own (the epigraph's slacks, one per joint and sample), from
+  // CostContext::firstVariable on; the problem is linear in them (after NlpProblem::
+  // nonlinearVariableCount), so the sample Hessians never see them.
+  virtual int variablesPerSample() const { return 0; }
+  /// Their bounds, one sample's (variablesPerSample() entries each).
+  virtual void sampleVariableBounds(Eigen::Ref<Eigen::VectorXd> /*lower*/, Eigen::Ref<Eigen::VectorXd> /*upper*/) const {}
+  /// Their values at a point whose motion is evaluated: one sample's, from its outputs.
+  virtual void startSampleVariables(const CostSample& /*sample*/, Eigen::Ref<Eigen::VectorXd> /*variables*/) const {}
 };
 
 using CostTerms = std::vector<std::unique_ptr<const CostTerm>>;
 
-/// The registry: the scenario's energy form, then the regularisation (cost_term.cpp).
+/// The registry: the scenario's energy form, then the regularisation (cost_term.cpp); each
+/// term's own variables after the previous term's, from context.firstVariable on.
 CostTerms makeCostTerms(const CostContext& context);
 
 // The bundled terms.

@@ -6,6 +6,8 @@
 //   epigraph        Σ_j s_js, slacks of x that the epigraph's rows s_js − P_js ≥ 0
 //                   (energy_epigraph_term.cpp) and their lower bound 0 make max(P_js, 0) at the
 //                   optimum: linear in x.
+#include <algorithm>
+
 #include "core/robot_model.hpp"
 #include "outer_nlp/cost_term.hpp"
 #include "outer_nlp/scenario.hpp"
@@ -68,8 +70,18 @@ class EpigraphEnergy final : public CostTerm {
     dT += weight / T * x.segment(first, n).sum();
   }
 
+  // A slack per joint, s ≥ 0, started at max(P, 0) of the motion's power (docs/theory/
+  // outer-problem.md, "Continuation"): the epigraph's rows hold there with equality or slack.
+  int variablesPerSample() const override { return c_.outputs.joints; }
+  void sampleVariableBounds(Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd>) const override {
+    lower.setZero();
+  }
+  void startSampleVariables(const CostSample& sample, Eigen::Ref<Eigen::VectorXd> slacks) const override {
+    for (int j = 0; j < c_.outputs.joints; ++j) slacks[j] = std::max(0.0, sample.y[c_.outputs.power(j)]);
+  }
+
  private:
-  int firstSlack(const CostSample& sample) const { return c_.slackStart + sample.index * c_.outputs.joints; }
+  int firstSlack(const CostSample& sample) const { return c_.firstVariable + sample.index * c_.outputs.joints; }
   CostContext c_;
 };
 

@@ -130,16 +130,16 @@ Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParamete
     }
     formulation_->fit(wrenches, x.segment(forceStart_, forceVariableCount()));
   }
-  setSlacksAtPower(x);
+  startCostVariables(x);
   return x;
 }
 
-void MotionProblem::setSlacksAtPower(Eigen::VectorXd& x) {
-  if (scenario_.energyForm != EnergyForm::Epigraph) return;
+void MotionProblem::startCostVariables(Eigen::VectorXd& x) {
+  if (variableCount_ == slackStart_) return;  // no cost term has variables of its own
   evaluate(x, false);
-  for (int s = 0; s < samples_.sampleCount(); ++s)
-    for (int j = 0; j < jointCount_; ++j)
-      x[slackIndex(s, j)] = std::max(0.0, blocks_[static_cast<std::size_t>(s)].y[outputs_.power(j)]);
+  for (int first = slackStart_; const auto& cost : costs_)
+    for (int s = 0, size = cost->variablesPerSample(); s < samples_.sampleCount(); ++s, first += size)
+      cost->startSampleVariables(costSample(s, blocks_[static_cast<std::size_t>(s)]), x.segment(first, size));
 }
 
 Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x) {
@@ -185,7 +185,7 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
     }
     formulation_->fit(wrenches, y.segment(forceStart_, forceVariableCount()));
   }
-  setSlacksAtPower(y);
+  startCostVariables(y);
   return y;
 }
 

@@ -197,7 +197,6 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
     formulation.sampleModels.push_back(&modelOf(s)), formulation.sampleSurfaces.push_back(surfacesInContact(s));
   formulation_ = makeContactForceFormulation(formulation);
   slackStart_ = forceStart_ + forceVariableCount();
-  variableCount_ = slackStart_ + (scenario_.energyForm == EnergyForm::Epigraph ? jointCount_ * count : 0);
 
   for (int j = 0; j < jointCount_; ++j)
     if (scenario_.torqueLimits && std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(j)].torqueLimit))
@@ -285,6 +284,9 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
                                            relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_,
                                            taskOfInstant_});
   costs_ = makeCostTerms(CostContext{scenario_, outputs_, closure_.get(), parametrization_, samples_, slackStart_});
+  // The cost terms' own variables (the epigraph's slacks) come last.
+  variableCount_ = slackStart_;
+  for (const auto& cost : costs_) variableCount_ += cost->variablesPerSample() * count;
   buildStructure();
 }
 

@@ -436,9 +436,12 @@ class MotionProblem final : public NlpProblem {
   double rowValue(const Row& row, const Eigen::VectorXd& x, double duration) const;
   /// The reference surface, then the environment contacts in contact at the sample (their order).
   std::vector<ContactSurface> surfacesInContact(int sample) const;
+  /// The epigraph's slack of a joint at a sample, for its rows (energy_epigraph_term.cpp): the
+  /// epigraph energy's variables, the first cost term's (cost_term.cpp).
   int slackIndex(int sample, int joint) const { return slackStart_ + sample * jointCount_ + joint; }
-  /// The epigraph form's slacks of x at max(P, 0) of x's motion (nothing for the smooth maximum).
-  void setSlacksAtPower(Eigen::VectorXd& x);
+  /// The cost terms' own variables of x started from x's motion (CostTerm::startSampleVariables:
+  /// the epigraph's slacks at max(P, 0)); nothing to do when no term has any.
+  void startCostVariables(Eigen::VectorXd& x);
   /// The robot's dynamics at sample s: with the ball while it is carried.
   const DynamicsModel& modelOf(int s) const { return loaded_[static_cast<std::size_t>(s)] ? *loadedModel_ : model_; }
 

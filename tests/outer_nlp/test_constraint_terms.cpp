@@ -182,6 +182,16 @@ TEST_CASE("cost terms: each energy form's objective is the sampled energy, and t
     REQUIRE(plain.costs().size() == 2);
     CHECK(plain.costs()[0]->name() == (form == EnergyForm::Epigraph ? "energy (epigraph)" : "energy (smooth maximum)"));
     CHECK(plain.costs()[1]->name() == "acceleration regularisation");
+    // The epigraph's slacks are its term's own variables: one per joint and sample, after every
+    // other variable, ≥ 0 (and started at max(P, 0) above: E equals the sampled energy).
+    const int own = plain.costs()[0]->variablesPerSample();
+    CHECK(own == (form == EnergyForm::Epigraph ? s.robot.jointCount() : 0));
+    CHECK(plain.costs()[1]->variablesPerSample() == 0);
+    CHECK(plain.variableCount() == plain.nonlinearVariableCount() + own * plain.sampleCount());
+    Eigen::VectorXd lower, upper;
+    plain.variableBounds(lower, upper);
+    CHECK((lower.tail(own * plain.sampleCount()).array() == 0.0).all());
+    CHECK((upper.tail(own * plain.sampleCount()).array() == std::numeric_limits<double>::infinity()).all());
     const double E = plain.objective(x);
     if (form == EnergyForm::Epigraph) {
       CHECK(E == Approx(physics.energy).epsilon(1e-12));
