@@ -137,9 +137,9 @@ Eigen::VectorXd MotionProblem::motionPoint(const Eigen::VectorXd& motionParamete
 void MotionProblem::startCostVariables(Eigen::VectorXd& x) {
   if (variableCount_ == slackStart_) return;  // no cost term has variables of its own
   evaluate(x, false);
-  for (int first = slackStart_; const auto& cost : costs_)
-    for (int s = 0, size = cost->variablesPerSample(); s < samples_.sampleCount(); ++s, first += size)
-      cost->startSampleVariables(costSample(s, blocks_[static_cast<std::size_t>(s)]), x.segment(first, size));
+  forEachCostVariableBlock([&](const CostTerm& cost, int s, int first, int size) {
+    cost.startSampleVariables(costSample(s, blocks_[static_cast<std::size_t>(s)]), x.segment(first, size));
+  });
 }
 
 Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x) {

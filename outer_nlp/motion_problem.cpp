@@ -286,7 +286,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   costs_ = makeCostTerms(CostContext{scenario_, outputs_, closure_.get(), parametrization_, samples_, slackStart_});
   // The cost terms' own variables (the epigraph's slacks) come last.
   variableCount_ = slackStart_;
-  for (const auto& cost : costs_) variableCount_ += cost->variablesPerSample() * count;
+  forEachCostVariableBlock([&](const CostTerm&, int, int, int size) { variableCount_ += size; });
   buildStructure();
 }
 

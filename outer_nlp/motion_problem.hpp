@@ -442,6 +442,15 @@ class MotionProblem final : public NlpProblem {
   /// The cost terms' own variables of x started from x's motion (CostTerm::startSampleVariables:
   /// the epigraph's slacks at max(P, 0)); nothing to do when no term has any.
   void startCostVariables(Eigen::VectorXd& x);
+  /// Each cost term's own variables at each sample, in x's order (makeCostTerms's layout, after
+  /// every other variable): f(term, sample, first index in x, count).
+  template <class F>
+  void forEachCostVariableBlock(F&& f) const {
+    int first = slackStart_;
+    for (const auto& cost : costs_)
+      for (int s = 0, size = cost->variablesPerSample(); size > 0 && s < samples_.sampleCount(); ++s, first += size)
+        f(*cost, s, first, size);
+  }
   /// The robot's dynamics at sample s: with the ball while it is carried.
   const DynamicsModel& modelOf(int s) const { return loaded_[static_cast<std::size_t>(s)] ? *loadedModel_ : model_; }
 

@@ -164,9 +164,9 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
       if (unusedParameter_[static_cast<std::size_t>(j * m + l)]) lower[j * m + l] = upper[j * m + l] = scenario_.start[j];
   if (durationIsFree()) lower[parameterCount_] = scenario_.duration.lower, upper[parameterCount_] = scenario_.duration.upper;
   formulation_->variableBounds(lower, upper);
-  for (int first = slackStart_; const auto& cost : costs_)
-    for (int s = 0, size = cost->variablesPerSample(); s < samples_.sampleCount(); ++s, first += size)
-      cost->sampleVariableBounds(lower.segment(first, size), upper.segment(first, size));
+  forEachCostVariableBlock([&](const CostTerm& cost, int, int first, int size) {
+    cost.sampleVariableBounds(lower.segment(first, size), upper.segment(first, size));
+  });
 }
 
 void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
