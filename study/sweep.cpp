@@ -149,6 +149,46 @@ VariedField readVariedField(const std::filesystem::path& file, const YAML::Node&
   return f;
 }
 
+/// One entry of `vary:`: a field, or fields varied `together:` (lists of one length, the k-th
+/// values in one case). Each field is checked against those read before it (`earlier`).
+std::vector<VariedField> readAxis(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, bool grid,
+                                  std::size_t axis, const std::vector<VariedField>& earlier) {
+  std::vector<VariedField> fields;
+  std::vector<std::pair<YAML::Node, std::string>> entries;  // each field's node and its name in messages
+  if (node.IsMap() && node["together"]) {
+    yaml::rejectUnknownKeys(file, node, field, {"together"});
+    const YAML::Node list = node["together"];
+    if (!list.IsSequence() || list.size() < 2)
+      throw InputError(where(file, list, field + ".together") + "expected a list of at least two fields, each with its values");
+    for (std::size_t j = 0; j < list.size(); ++j) entries.emplace_back(list[j], field + ".together[" + std::to_string(j) + "]");
+  } else {
+    entries.emplace_back(node, field);
+  }
+  for (const auto& [entry, name] : entries) {
+    VariedField f = readVariedField(file, entry, name, grid);
+    f.axis = axis;
+    if (entries.size() > 1) {
+      if (f.isRange) throw InputError(where(file, entry["range"], name + ".range") + "fields varied together list their values, not a range");
+      if (!fields.empty() && f.values.size() != fields.front().values.size())
+        throw InputError(where(file, entry["values"], name + ".values") + std::to_string(f.values.size()) + " values where " +
+                         fields.front().path.text + " has " + std::to_string(fields.front().values.size()) +
+                         ": fields varied together list as many values");
+    }
+    for (const std::vector<VariedField>* list : {&earlier, static_cast<const std::vector<VariedField>*>(&fields)})
+      for (const VariedField& other : *list)
+        if (other.path.text == f.path.text) throw InputError(where(file, entry["field"], name + ".field") + "'" + f.path.text + "' is varied twice");
+    fields.push_back(std::move(f));
+  }
+  return fields;
+}
+
+/// The fields of each axis, by their index in Sweep::varied.
+std::vector<std::vector<std::size_t>> fieldsByAxis(const Sweep& sweep) {
+  std::vector<std::vector<std::size_t>> axes(sweep.axes);
+  for (std::size_t i = 0; i < sweep.varied.size(); ++i) axes[sweep.varied[i].axis].push_back(i);
+  return axes;
+}
+
 }  // namespace
 
 const char* toString(Design design) {
@@ -213,17 +253,13 @@ Sweep loadSweep(const std::filesystem::path& file) {
   const YAML::Node vary = yaml::required(file, root, "vary", "");
   if (!vary.IsSequence()) throw InputError(where(file, vary, "vary") + "expected a list of fields to vary");
   if (vary.size() == 0) throw InputError(where(file, vary, "vary") + "an empty design: list at least one field to vary");
-  for (std::size_t i = 0; i < vary.size(); ++i) {
-    const std::string field = "vary[" + std::to_string(i) + "]";
-    VariedField f = readVariedField(file, vary[i], field, grid);
-    for (const VariedField& other : s.varied)
-      if (other.path.text == f.path.text) throw InputError(where(file, vary[i]["field"], field + ".field") + "'" + f.path.text + "' is varied twice");
-    s.varied.push_back(std::move(f));
-  }
+  for (std::size_t i = 0; i < vary.size(); ++i)
+    for (VariedField& f : readAxis(file, vary[i], "vary[" + std::to_string(i) + "]", grid, i, s.varied)) s.varied.push_back(std::move(f));
+  s.axes = vary.size();
   std::size_t combinations = 1;
   if (grid)
-    for (const VariedField& f : s.varied) {
-      combinations *= f.values.size();
+    for (const std::vector<std::size_t>& axis : fieldsByAxis(s)) {
+      combinations *= s.varied[axis.front()].values.size();
       if (combinations > 1000000) throw InputError(where(file, vary, "vary") + "a grid of more than a million cases");
     }
 
@@ -261,16 +297,17 @@ Sweep loadSweep(const std::filesystem::path& file) {
 std::vector<StudyCase> designCases(const Sweep& sweep) {
   YAML::Node base = baseTree(sweep);
   for (const FixedField& f : sweep.fixed) apply(base, f.path, f.value, f.origin);
+  const std::vector<std::vector<std::size_t>> axes = fieldsByAxis(sweep);
   std::vector<std::vector<YAML::Node>> rows;
   if (sweep.design == Design::Grid) {
     std::size_t count = 1;
-    for (const VariedField& f : sweep.varied) count *= f.values.size();
+    for (const auto& axis : axes) count *= sweep.varied[axis.front()].values.size();
     for (std::size_t k = 0; k < count; ++k) {
       std::vector<YAML::Node> row(sweep.varied.size());
       std::size_t rest = k;
-      for (std::size_t i = sweep.varied.size(); i-- > 0;) {  // the last field fastest
-        const std::size_t n = sweep.varied[i].values.size();
-        row[i] = YAML::Clone(sweep.varied[i].values[rest % n]);
+      for (std::size_t a = axes.size(); a-- > 0;) {  // the last axis fastest
+        const std::size_t n = sweep.varied[axes[a].front()].values.size();
+        for (std::size_t i : axes[a]) row[i] = YAML::Clone(sweep.varied[i].values[rest % n]);
         rest /= n;
       }
       rows.push_back(std::move(row));
@@ -279,9 +316,10 @@ std::vector<StudyCase> designCases(const Sweep& sweep) {
     std::mt19937_64 rng(sweep.seed);
     const std::size_t n = sweep.randomCases;
     rows.assign(n, std::vector<YAML::Node>(sweep.varied.size()));
-    for (std::size_t i = 0; i < sweep.varied.size(); ++i) {
-      // Latin hypercube: each field's n strata [k/n, (k+1)/n) used once, in a random order
+    for (const auto& axis : axes) {
+      // Latin hypercube: each axis's n strata [k/n, (k+1)/n) used once, in a random order
       // (Fisher–Yates on the engine's own integers, for the same order on every platform).
+      // Fields varied together share the draw, hence the index into their lists.
       std::vector<std::size_t> strata(n);
       for (std::size_t k = 0; k < n; ++k) strata[k] = k;
       if (sweep.design == Design::LatinHypercube)
@@ -290,7 +328,7 @@ std::vector<StudyCase> designCases(const Sweep& sweep) {
         const double u = sweep.design == Design::LatinHypercube
                              ? (static_cast<double>(strata[k]) + unitDraw(rng)) / static_cast<double>(n)
                              : unitDraw(rng);
-        rows[k][i] = drawnValue(sweep.varied[i], u);
+        for (std::size_t i : axis) rows[k][i] = drawnValue(sweep.varied[i], u);
       }
     }
   }
@@ -317,22 +355,31 @@ void validateCases(const Sweep& sweep, const std::vector<StudyCase>& cases) {
     apply(base, f.path, f.value, f.origin);
   }
   if (sweep.fixed.size() > 1) check(sweep, base, sweep.fixed.front().origin, "the set fields together");
-  // Each value on its own first, so that a refusal points at the value's line.
-  for (const VariedField& f : sweep.varied) {
-    std::vector<YAML::Node> probes = f.values;
-    if (f.isRange) {
-      probes.clear();
+  // Each value on its own first (with the values varied together with it), so that a refusal
+  // points at the value's line.
+  for (const std::vector<std::size_t>& axis : fieldsByAxis(sweep)) {
+    const auto probes = [&](const VariedField& f) {
+      if (!f.isRange) return f.values;
+      std::vector<YAML::Node> ends;
       for (double end : {f.lower, f.upper}) {
         YAML::Node v;
         if (f.integer) v = static_cast<long long>(std::llround(end));
         else v = shortest(end);
-        probes.push_back(v);
+        ends.push_back(v);
       }
-    }
-    for (std::size_t j = 0; j < probes.size(); ++j) {
+      return ends;
+    };
+    const VariedField& first = sweep.varied[axis.front()];
+    for (std::size_t j = 0; j < probes(first).size(); ++j) {
       YAML::Node single = YAML::Clone(base);
-      apply(single, f.path, probes[j], f.valueOrigins[j]);
-      check(sweep, single, f.valueOrigins[j], f.path.text + " = " + valueText(probes[j]));
+      std::string what;
+      for (std::size_t i : axis) {
+        const VariedField& f = sweep.varied[i];
+        const YAML::Node value = probes(f)[j];
+        apply(single, f.path, value, f.valueOrigins[j]);
+        what += (what.empty() ? "" : ", ") + f.path.text + " = " + valueText(value);
+      }
+      check(sweep, single, first.valueOrigins[j], what);
     }
   }
   for (const StudyCase& c : cases) {

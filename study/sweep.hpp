@@ -29,8 +29,11 @@ struct FixedField {
 
 /// A varied field (`vary:`): a list of values (a grid's axis, or choices drawn by a random
 /// design), or a numeric range [lower, upper] (random and Latin-hypercube designs only).
+/// Fields listed under one `together:` share an axis: lists of one length, the k-th values
+/// of all of them in the same case (a duration and the instants scaled with it).
 struct VariedField {
   FieldPath path;
+  std::size_t axis = 0;  ///< the `vary:` entry it belongs to; fields of one `together:` share it
   std::vector<YAML::Node> values;
   std::vector<std::string> valueOrigins;  ///< "sweep.yaml:12: vary[0].values[1]"
   bool isRange = false;
@@ -61,7 +64,8 @@ struct Sweep {
   Design design = Design::Grid;
   std::size_t randomCases = 0;  ///< random and Latin-hypercube designs
   std::uint64_t seed = 1;
-  std::vector<VariedField> varied;
+  std::vector<VariedField> varied;  ///< every varied field, axis by axis
+  std::size_t axes = 0;             ///< the entries of `vary:`
   CaseResources resources;
   SlurmSettings slurm;
 };
@@ -77,8 +81,9 @@ struct StudyCase {
 Sweep loadSweep(const std::filesystem::path& file);
 
 /// The cases of the sweep's design, each with its scenario tree (not yet validated). A grid
-/// runs through its fields' values with the first field slowest; random and Latin-hypercube
-/// designs draw from std::mt19937_64 seeded with `seed` (the same cases on every platform).
+/// runs through its axes' values with the first axis slowest; random and Latin-hypercube
+/// designs draw from std::mt19937_64 seeded with `seed` (the same cases on every platform),
+/// one draw an axis.
 std::vector<StudyCase> designCases(const Sweep& sweep);
 
 /// Loads every case's scenario with the scenario loader. A value the scenario refuses is

@@ -117,6 +117,44 @@ TEST_CASE("study: a grid runs through every combination, the first field slowest
   REQUIRE_NOTHROW(validateCases(sweep, cases));
 }
 
+TEST_CASE("study: fields varied together take their k-th values in one case", "[study]") {
+  const test::TempDir dir;
+  // The kick's duration with its instant and its foot's window: alone, 1.2 s would leave the
+  // 1.6 s window beyond the motion; together they make valid cases.
+  const std::string body = "vary:\n"
+                           "  - together:\n"
+                           "      - {field: duration, values: [1.2, 1.6, 2.0]}\n"
+                           "      - {field: 'tasks[kick].time', values: [0.6, 0.8, 1.0]}\n"
+                           "      - {field: 'tasks[right foot in the air].window[1]', values: [1.2, 1.6, 2.0]}\n"
+                           "  - {field: 'tasks[kick].target[0]', values: [0.8, 1.2]}\n";
+  const Sweep sweep = loadSweep(writeSweep(dir, body));
+  CHECK(sweep.axes == 2);
+  REQUIRE(sweep.varied.size() == 4);
+  const std::vector<StudyCase> cases = designCases(sweep);
+  REQUIRE(cases.size() == 6);
+  for (const StudyCase& c : cases) {
+    const double duration = c.values[0].as<double>();
+    CHECK(c.values[1].as<double>() == Approx(duration / 2));
+    CHECK(c.values[2].as<double>() == duration);
+    CHECK(c.scenario["duration"].as<double>() == duration);
+    CHECK(c.scenario["tasks"][1]["window"][1].as<double>() == duration);
+    CHECK(c.values[3].as<double>() == (c.index % 2 == 0 ? 0.8 : 1.2));  // the last axis fastest
+  }
+  CHECK(cases[2].values[0].as<double>() == 1.6);
+  REQUIRE_NOTHROW(validateCases(sweep, cases));
+  // Random designs draw once an axis: the fields of one keep their pairing.
+  const Sweep drawn = loadSweep(writeSweep(dir, "design: latin-hypercube\ncases: 6\n" + body));
+  for (const StudyCase& c : designCases(drawn)) {
+    CHECK(c.values[1].as<double>() == Approx(c.values[0].as<double>() / 2));
+    CHECK(c.values[2].as<double>() == c.values[0].as<double>());
+  }
+  // A refused value of the group is reported at its line, with the values it was tried with.
+  const std::string refused = loadError(writeSweep(dir,
+                                                   "vary:\n  - together:\n      - {field: duration, values: [1.6, 1.2]}\n"
+                                                   "      - {field: 'tasks[kick].time', values: [0.8, 1.4]}\n"));
+  CHECK_THAT(refused, Contains("sweep.yaml:4: vary[0].together[0].values[1]: duration = 1.2, tasks[kick].time = 1.4: the scenario refuses it:"));
+}
+
 TEST_CASE("study: random and Latin-hypercube designs are seeded, in range, and stratified", "[study]") {
   const test::TempDir dir;
   const std::string fields = "vary:\n  - {field: objective.acceleration_weight, range: [0.001, 1.0], scale: log}\n"
@@ -184,6 +222,13 @@ TEST_CASE("study: bad sweep files are refused at their line and field", "[study]
       {"vary:\n  - {field: samples, values: [10]}\nresources: {time: -3}\n", "sweep.yaml:4: resources.time: must be positive"},
       {"vary:\n  - {field: samples, values: [10]}\nslurm: {queue: x}\n", "sweep.yaml:4: slurm.queue: unknown key"},
       {"vary:\n  - {field: samples, values: [10]}\nextra: 1\n", "sweep.yaml:4: extra: unknown key"},
+      {"vary:\n  - together:\n      - {field: samples, values: [10, 12]}\n      - {field: duration, values: [1.6]}\n",
+       "sweep.yaml:5: vary[0].together[1].values: 1 values where samples has 2: fields varied together list as many values"},
+      {"design: random\ncases: 2\nvary:\n  - together:\n      - {field: samples, values: [10, 12]}\n      - {field: duration, range: [1, 2]}\n",
+       "sweep.yaml:7: vary[0].together[1].range: fields varied together list their values, not a range"},
+      {"vary:\n  - together:\n      - {field: samples, values: [10]}\n", "sweep.yaml:4: vary[0].together: expected a list of at least two fields"},
+      {"vary:\n  - together:\n      - {field: samples, values: [10]}\n      - {field: samples, values: [12]}\n",
+       "sweep.yaml:5: vary[0].together[1].field: 'samples' is varied twice"},
   };
   for (const Case& c : cases) {
     INFO(c.body);
@@ -196,11 +241,18 @@ TEST_CASE("study: bad sweep files are refused at their line and field", "[study]
   CHECK_THAT(together, Contains("sweep.yaml:4: vary[0]: case 3 (duration = 1.7, tasks[kick].time = 1.8): the scenario refuses it: tasks[0].time:"));
 }
 
-TEST_CASE("study: the bundled sweep's cases are valid scenarios", "[study]") {
-  const Sweep sweep = loadSweep(test::sourceDir() / "scenarios/studies/throw_targets.yaml");
-  const std::vector<StudyCase> cases = designCases(sweep);
-  CHECK(cases.size() >= 4);
-  REQUIRE_NOTHROW(validateCases(sweep, cases));
+TEST_CASE("study: the bundled sweeps' cases are valid scenarios", "[study]") {
+  std::size_t sweeps = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(test::sourceDir() / "scenarios/studies")) {
+    if (entry.path().extension() != ".yaml") continue;
+    INFO(entry.path());
+    const Sweep sweep = loadSweep(entry.path());
+    const std::vector<StudyCase> cases = designCases(sweep);
+    CHECK(cases.size() >= 4);
+    REQUIRE_NOTHROW(validateCases(sweep, cases));
+    ++sweeps;
+  }
+  CHECK(sweeps >= 4);
 }
 
 TEST_CASE("study: array ranges as sbatch writes them", "[study]") {
