@@ -152,8 +152,7 @@ VariedField readVariedField(const std::filesystem::path& file, const YAML::Node&
 /// One entry of `vary:`: a field, or fields varied `together:` (lists of one length, the k-th
 /// values in one case). Each field is checked against those read before it (`earlier`).
 std::vector<VariedField> readAxis(const std::filesystem::path& file, const YAML::Node& node, const std::string& field, bool grid,
-                                  std::size_t axis, const std::vector<VariedField>& earlier) {
-  std::vector<VariedField> fields;
+                                  const std::vector<VariedField>& earlier) {
   std::vector<std::pair<YAML::Node, std::string>> entries;  // each field's node and its name in messages
   if (node.IsMap() && node["together"]) {
     yaml::rejectUnknownKeys(file, node, field, {"together"});
@@ -164,9 +163,13 @@ std::vector<VariedField> readAxis(const std::filesystem::path& file, const YAML:
   } else {
     entries.emplace_back(node, field);
   }
+  std::vector<VariedField> fields;
+  const auto variedBefore = [&](const FieldPath& path) {
+    const auto same = [&](const VariedField& other) { return other.path.text == path.text; };
+    return std::any_of(earlier.begin(), earlier.end(), same) || std::any_of(fields.begin(), fields.end(), same);
+  };
   for (const auto& [entry, name] : entries) {
     VariedField f = readVariedField(file, entry, name, grid);
-    f.axis = axis;
     if (entries.size() > 1) {
       if (f.isRange) throw InputError(where(file, entry["range"], name + ".range") + "fields varied together list their values, not a range");
       if (!fields.empty() && f.values.size() != fields.front().values.size())
@@ -174,19 +177,23 @@ std::vector<VariedField> readAxis(const std::filesystem::path& file, const YAML:
                          fields.front().path.text + " has " + std::to_string(fields.front().values.size()) +
                          ": fields varied together list as many values");
     }
-    for (const std::vector<VariedField>* list : {&earlier, static_cast<const std::vector<VariedField>*>(&fields)})
-      for (const VariedField& other : *list)
-        if (other.path.text == f.path.text) throw InputError(where(file, entry["field"], name + ".field") + "'" + f.path.text + "' is varied twice");
+    if (variedBefore(f.path)) throw InputError(where(file, entry["field"], name + ".field") + "'" + f.path.text + "' is varied twice");
     fields.push_back(std::move(f));
   }
   return fields;
 }
 
-/// The fields of each axis, by their index in Sweep::varied.
-std::vector<std::vector<std::size_t>> fieldsByAxis(const Sweep& sweep) {
-  std::vector<std::vector<std::size_t>> axes(sweep.axes);
-  for (std::size_t i = 0; i < sweep.varied.size(); ++i) axes[sweep.varied[i].axis].push_back(i);
-  return axes;
+/// The values a field is checked with on its own: its list, or a range's two ends.
+std::vector<YAML::Node> probeValues(const VariedField& f) {
+  if (!f.isRange) return f.values;
+  std::vector<YAML::Node> ends;
+  for (double end : {f.lower, f.upper}) {
+    YAML::Node v;
+    if (f.integer) v = static_cast<long long>(std::llround(end));
+    else v = shortest(end);
+    ends.push_back(v);
+  }
+  return ends;
 }
 
 }  // namespace
@@ -253,12 +260,16 @@ Sweep loadSweep(const std::filesystem::path& file) {
   const YAML::Node vary = yaml::required(file, root, "vary", "");
   if (!vary.IsSequence()) throw InputError(where(file, vary, "vary") + "expected a list of fields to vary");
   if (vary.size() == 0) throw InputError(where(file, vary, "vary") + "an empty design: list at least one field to vary");
-  for (std::size_t i = 0; i < vary.size(); ++i)
-    for (VariedField& f : readAxis(file, vary[i], "vary[" + std::to_string(i) + "]", grid, i, s.varied)) s.varied.push_back(std::move(f));
-  s.axes = vary.size();
+  for (std::size_t i = 0; i < vary.size(); ++i) {
+    std::vector<std::size_t>& axis = s.axes.emplace_back();
+    for (VariedField& f : readAxis(file, vary[i], "vary[" + std::to_string(i) + "]", grid, s.varied)) {
+      axis.push_back(s.varied.size());
+      s.varied.push_back(std::move(f));
+    }
+  }
   std::size_t combinations = 1;
   if (grid)
-    for (const std::vector<std::size_t>& axis : fieldsByAxis(s)) {
+    for (const std::vector<std::size_t>& axis : s.axes) {
       combinations *= s.varied[axis.front()].values.size();
       if (combinations > 1000000) throw InputError(where(file, vary, "vary") + "a grid of more than a million cases");
     }
@@ -297,7 +308,7 @@ Sweep loadSweep(const std::filesystem::path& file) {
 std::vector<StudyCase> designCases(const Sweep& sweep) {
   YAML::Node base = baseTree(sweep);
   for (const FixedField& f : sweep.fixed) apply(base, f.path, f.value, f.origin);
-  const std::vector<std::vector<std::size_t>> axes = fieldsByAxis(sweep);
+  const std::vector<std::vector<std::size_t>>& axes = sweep.axes;
   std::vector<std::vector<YAML::Node>> rows;
   if (sweep.design == Design::Grid) {
     std::size_t count = 1;
@@ -357,25 +368,16 @@ void validateCases(const Sweep& sweep, const std::vector<StudyCase>& cases) {
   if (sweep.fixed.size() > 1) check(sweep, base, sweep.fixed.front().origin, "the set fields together");
   // Each value on its own first (with the values varied together with it), so that a refusal
   // points at the value's line.
-  for (const std::vector<std::size_t>& axis : fieldsByAxis(sweep)) {
-    const auto probes = [&](const VariedField& f) {
-      if (!f.isRange) return f.values;
-      std::vector<YAML::Node> ends;
-      for (double end : {f.lower, f.upper}) {
-        YAML::Node v;
-        if (f.integer) v = static_cast<long long>(std::llround(end));
-        else v = shortest(end);
-        ends.push_back(v);
-      }
-      return ends;
-    };
+  for (const std::vector<std::size_t>& axis : sweep.axes) {
+    std::vector<std::vector<YAML::Node>> probes;  // per field of the axis, lists of one length
+    for (std::size_t i : axis) probes.push_back(probeValues(sweep.varied[i]));
     const VariedField& first = sweep.varied[axis.front()];
-    for (std::size_t j = 0; j < probes(first).size(); ++j) {
+    for (std::size_t j = 0; j < probes.front().size(); ++j) {
       YAML::Node single = YAML::Clone(base);
       std::string what;
-      for (std::size_t i : axis) {
-        const VariedField& f = sweep.varied[i];
-        const YAML::Node value = probes(f)[j];
+      for (std::size_t a = 0; a < axis.size(); ++a) {
+        const VariedField& f = sweep.varied[axis[a]];
+        const YAML::Node& value = probes[a][j];
         apply(single, f.path, value, f.valueOrigins[j]);
         what += (what.empty() ? "" : ", ") + f.path.text + " = " + valueText(value);
       }

@@ -29,11 +29,10 @@ struct FixedField {
 
 /// A varied field (`vary:`): a list of values (a grid's axis, or choices drawn by a random
 /// design), or a numeric range [lower, upper] (random and Latin-hypercube designs only).
-/// Fields listed under one `together:` share an axis: lists of one length, the k-th values
-/// of all of them in the same case (a duration and the instants scaled with it).
+/// Fields listed under one `together:` share an axis (Sweep::axes): lists of one length, the
+/// k-th values of all of them in the same case (a duration and the instants scaled with it).
 struct VariedField {
   FieldPath path;
-  std::size_t axis = 0;  ///< the `vary:` entry it belongs to; fields of one `together:` share it
   std::vector<YAML::Node> values;
   std::vector<std::string> valueOrigins;  ///< "sweep.yaml:12: vary[0].values[1]"
   bool isRange = false;
@@ -65,7 +64,8 @@ struct Sweep {
   std::size_t randomCases = 0;  ///< random and Latin-hypercube designs
   std::uint64_t seed = 1;
   std::vector<VariedField> varied;  ///< every varied field, axis by axis
-  std::size_t axes = 0;             ///< the entries of `vary:`
+  /// One per entry of `vary:`: its fields' indices in `varied` (several for `together:`).
+  std::vector<std::vector<std::size_t>> axes;
   CaseResources resources;
   SlurmSettings slurm;
 };
