@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // `mcopt inner`: solve inner contact-force problems given as data (formulation.md §7), one
 // per time sample, with a chosen solver and contact model. Formats: docs/theory/inner-problem.md.
+#include <cmath>
 #include <iostream>
 #include <optional>
 #include <map>
@@ -23,6 +24,7 @@ struct InnerOptions {
   double tikhonov = 1e-9;
   bool cold = false;
   bool polish = false;
+  std::optional<double> barrier;
 };
 
 using json_io::Json;
@@ -41,6 +43,13 @@ int runInner(const InnerOptions& o) {
   InnerSettings solverSettings;
   solverSettings.warmStart = !o.cold;
   solverSettings.polish = o.polish;
+  if (o.barrier) {
+    if (o.solver != "barrier")
+      throw InputError("--barrier: only the barrier inner solver has a barrier parameter (the solver is " + o.solver + ")");
+    if (!(*o.barrier > 0.0) || !std::isfinite(*o.barrier))
+      throw InputError("--barrier: must be a positive number, got " + std::to_string(*o.barrier));
+    solverSettings.barrier = *o.barrier;
+  }
   auto solver = makeInnerSolver(o.solver, solverSettings);
   SensitivitySettings sensitivitySettings;
   sensitivitySettings.backend = parseKktBackend(o.kktBackend);
@@ -104,6 +113,9 @@ Runner addInner(CLI::App& app) {
   app.add_flag("--cold", o->cold, "do not warm-start each problem from the previous one's result");
   app.add_flag("--polish", o->polish,
                "slsqp, ipopt: polish each answer on its own active set (linear contact models; docs/theory/inner-problem.md)");
+  app.add_option("--barrier", o->barrier,
+                 "barrier: the central-path parameter μ in W (default 1e-3); each objective lies at most rows × μ above "
+                 "its exact minimum (docs/theory/inner-problem.md)");
   app.add_flag("--sensitivity", o->sensitivity,
                "add dwrenches_dtau0 and dwrenches_dbalance (formulation.md §8) to each optimal result");
   app.add_option("--kkt-backend", o->kktBackend, "factorisation of the sensitivity's KKT system: dense (default), klu, umfpack");

@@ -104,6 +104,7 @@ Json innerResultToJson(const ContactProblem& p, const InnerResult& r) {
   out["iterations"] = r.iterations;
   out["kkt_residual"] = r.kktResidual;
   out["polished"] = r.polished;
+  out["barrier"] = r.barrier;  // 0: an exact optimum; μ: the barrier solver's central point
   out["solve_time_us"] = r.solveTimeUs;
   out["balance_slack"] = json_io::toJson(r.balanceSlack);
   if (!r.message.empty()) out["message"] = r.message;

@@ -34,6 +34,8 @@ const std::vector<InnerSolverEntry>& innerSolvers() {
        makeActiveSetSolver},
       {"slsqp", "NLopt's SLSQP (sequential quadratic programming; the report's FSQP analogue)", makeSlsqpSolver},
       {"ipopt", "Ipopt's interior point, one NLP a solve (the report's baseline)", makeIpoptSolver},
+      {"barrier", "ours: the central path of a fixed barrier parameter, a smooth answer for the outer problem (linear contact models)",
+       makeBarrierSolver},
       {"auglag-mma", "NLopt's augmented Lagrangian over every constraint, MMA (moving asymptotes) on its subproblems",
        makeAugLagMmaSolver},
       {"auglag-lbfgs", "NLopt's augmented Lagrangian over every constraint, L-BFGS on its subproblems",
@@ -352,7 +354,7 @@ double kktResidual(const ContactProblem& p, const InnerResult& r) {
   for (Eigen::Index i = 0; i < p.inequality.rows(); ++i) {
     const double value = p.inequality.row(i).dot(F) - p.inequalityBound[i];
     const double mu = r.inequalityMultipliers[i];
-    residual = std::max({residual, value, -mu, std::abs(mu * value)});
+    residual = std::max({residual, value, -mu, std::abs(mu * value + r.barrier)});
   }
   // Cones: F_i in the cone, y_i in the dual cone, y_iᵀ F_i = 0.
   for (std::size_t k = 0; k < p.cones.size(); ++k) {

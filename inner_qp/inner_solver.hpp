@@ -30,6 +30,11 @@ struct InnerSettings {
   /// SLSQP and Ipopt: polish each answer on its own active set (linear contact models; the
   /// report model's cones are left as solved). docs/theory/inner-problem.md, "Polishing".
   bool polish = false;
+  /// The barrier solver: the central-path parameter μ > 0 at which it stops, in the objective's
+  /// units (W). Its answer's objective lies at most (linear rows) × μ above the exact minimum,
+  /// and is a smooth function of the data (docs/theory/inner-problem.md, "The barrier-smoothed
+  /// inner problem"). Other solvers do not read it.
+  double barrier = 1e-3;
 };
 
 struct InnerResult {
@@ -56,6 +61,9 @@ struct InnerResult {
   /// at which (∂B/∂q) F differs). Meaningful only when Infeasible.
   Eigen::VectorXd leastSlackWrenches;
   bool polished = false;                ///< the answer was polished on its active set (InnerSettings::polish)
+  /// 0: an exact optimum. μ > 0: the barrier solver's central-path point at μ, where every
+  /// row is strictly inside (s_i > 0), each multiplier is z_i = μ / s_i and `activeSet` is empty.
+  double barrier = 0.0;
   std::string message;                  ///< the underlying solver's own words
 };
 
@@ -72,6 +80,9 @@ std::unique_ptr<InnerSolver> makeIpoptSolver(const InnerSettings& settings = {})
 /// The in-house method (formulation.md §7): a dual active-set QP inside an SQP loop over the
 /// friction cones; allocation-free once it has seen a problem of the same size.
 std::unique_ptr<InnerSolver> makeActiveSetSolver(const InnerSettings& settings = {});
+/// The central path at a fixed μ (InnerSettings::barrier) of the linear contact models: a
+/// smooth answer for the bilevel outer problem (barrier_solver.cpp).
+std::unique_ptr<InnerSolver> makeBarrierSolver(const InnerSettings& settings = {});
 
 /// One registered inner solver: the name scenario files, `mcopt inner --solver` and the Python
 /// module know it by, one line saying what it is, and how to make it.
@@ -95,7 +106,8 @@ std::unique_ptr<InnerSolver> makeInnerSolver(const std::string& name, const Inne
 
 /// KKT residual of a result for its problem (balance shifted by the slack when Infeasible):
 /// the largest of ‖∇L‖∞ (stationarity, with the multipliers of the result), the constraint
-/// violation, and |multiplier × constraint| (complementarity), each relative to the data's scale.
+/// violation, and |multiplier × constraint| (complementarity; |multiplier × constraint + μ| for a
+/// barrier answer), each relative to the data's scale.
 /// Allocation-free.
 double kktResidual(const ContactProblem& problem, const InnerResult& result);
 

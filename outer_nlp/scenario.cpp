@@ -436,6 +436,10 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
         const YAML::Node stage = root["continuation"][k];
         throw InputError(where(file, stage["hessian"] ? stage["hessian"] : root["hessian"], field + ".hessian") + "exact: " + why);
       }
+  if (const std::string why = barrierModelRefusal(s); !why.empty()) {
+    const YAML::Node inner = root["inner"];
+    throw InputError(where(file, inner["contact_model"] ? inner["contact_model"] : inner["solver"], "inner.solver") + why);
+  }
   return s;
 }
 

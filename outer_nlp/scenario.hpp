@@ -147,6 +147,9 @@ bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario);
 /// and a prismatic joint are not; and the epigraph's slack × duration term lies outside the
 /// Hessian's variables.
 std::string exactHessianRefusal(const Scenario& scenario);
+/// Why the scenario's contact models do not suit its inner solver (empty when they do): the
+/// barrier solver smooths linear models only (inner.contact_model and every contacts[k].model).
+std::string barrierModelRefusal(const Scenario& scenario);
 
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws

@@ -43,7 +43,7 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
 }
 
 void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
-  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish"});
+  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish", "barrier"});
   if (node["solver"]) {
     const std::string name = yaml::text(file, node["solver"], "inner.solver");
     if (!isInnerSolverName(name))
@@ -72,6 +72,12 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
                      "), not to every contact — the reference contact carries moments");
   if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
   if (node["polish"]) s.inner.solver.polish = yaml::flag(file, node["polish"], "inner.polish");
+  if (node["barrier"]) {
+    if (s.inner.solverName != "barrier")
+      throw InputError(where(file, node["barrier"], "inner.barrier") + "only the barrier inner solver has a barrier parameter (the solver is " +
+                       s.inner.solverName + ")");
+    s.inner.solver.barrier = yaml::positive(file, node["barrier"], "inner.barrier");
+  }
   if (node["kkt_backend"]) {
     try {
       s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));
@@ -155,6 +161,17 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
 bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
   return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
          stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
+}
+
+std::string barrierModelRefusal(const Scenario& s) {
+  if (s.inner.solverName != "barrier") return {};
+  const std::string head = "the barrier inner solver smooths linear contact models only (pyramid, wrench-cone): ";
+  if (s.inner.problem.model->hasSecondOrderCone())
+    return head + "the " + s.inner.problem.model->name() + " model (inner.contact_model) has second-order friction cones";
+  for (const auto& [contact, model] : s.inner.problem.byContact)
+    if (model->hasSecondOrderCone())
+      return head + "contact '" + contact + "' has the " + model->name() + " model, with a second-order friction cone";
+  return {};
 }
 
 }  // namespace mcopt

@@ -221,6 +221,7 @@ An inner solver's result: status ('optimal', 'infeasible' with the least-norm ba
       .def_property_readonly("iterations", [](const InnerResultHandle& r) { return r.result.iterations; }, "the solver's iterations (its own count)")
       .def_property_readonly("kkt_residual", [](const InnerResultHandle& r) { return r.result.kktResidual; }, "largest of stationarity, feasibility and complementarity, relative to the data")
       .def_property_readonly("polished", [](const InnerResultHandle& r) { return r.result.polished; }, "whether the answer was polished on its active set (InnerSolver(polish=True))")
+      .def_property_readonly("barrier", [](const InnerResultHandle& r) { return r.result.barrier; }, "0 for an exact optimum; μ for the barrier solver's central point")
       .def_property_readonly("balance_slack", [](const InnerResultHandle& r) { return vectorToNumpy(r.result.balanceSlack); }, "(6,): the least-norm balance slack when 'infeasible', zero otherwise")
       .def_property_readonly("active_set", [](const InnerResultHandle& r) -> py::object { const py::dict d = resultDict(r); return d["active_set"]; },
                              "names of the active rows (and '<contact>.cone' for active cones)")
@@ -249,10 +250,11 @@ the factorisation `backend` (dense, klu or umfpack): {'dwrenches_dtau0', 'dwrenc
   py::class_<InnerSolverHandle, std::shared_ptr<InnerSolverHandle>>(m, "InnerSolver", R"doc(
 An inner solver by its registered name (`mcopt.inner_solvers()`: name → what it is).)doc")
       .def(py::init([](const std::string& name, double tolerance, double kktTolerance, int maxIterations, bool warmStart,
-                       bool polish) {
+                       bool polish, double barrier) {
              InnerSettings settings;
              settings.tolerance = tolerance, settings.kktTolerance = kktTolerance;
              settings.maxIterations = maxIterations, settings.warmStart = warmStart, settings.polish = polish;
+             settings.barrier = barrier;
              auto handle = std::make_shared<InnerSolverHandle>();
              handle->solver = makeInnerSolver(name, settings);
              handle->name = handle->solver->name();
@@ -260,8 +262,10 @@ An inner solver by its registered name (`mcopt.inner_solvers()`: name → what i
            }),
            py::arg("name") = "active-set", py::arg("tolerance") = 1e-9, py::arg("kkt_tolerance") = 1e-6,
            py::arg("max_iterations") = 500, py::arg("warm_start") = true, py::arg("polish") = false,
+           py::arg("barrier") = InnerSettings{}.barrier,
            "Settings as in inner_solver.hpp; `warm_start` False is `mcopt inner --cold`, `polish` True is "
-           "`mcopt inner --polish` (slsqp, ipopt: each answer polished on its own active set).")
+           "`mcopt inner --polish` (slsqp, ipopt: each answer polished on its own active set), `barrier` is "
+           "`mcopt inner --barrier` (the barrier solver's μ in W; the others do not read it).")
       .def_property_readonly("name", [](const InnerSolverHandle& s) { return s.name; }, "its registered name")
       .def(
           "solve",

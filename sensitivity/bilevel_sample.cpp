@@ -36,6 +36,8 @@ void BilevelSample::warmStartFrom(const BilevelSample& other) {
   result_.activeSet = other.result_.activeSet;
   result_.inequalityMultipliers = other.result_.inequalityMultipliers;
   result_.coneMultipliers = other.result_.coneMultipliers;
+  result_.balanceMultipliers = other.result_.balanceMultipliers;
+  result_.barrier = other.result_.barrier;
 }
 
 void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives* d,

@@ -255,7 +255,22 @@ const SensitivityDiagnostics& InnerSensitivity::factorize(const ContactProblem& 
     m.kkt(column, next) = 1.0;
     ++next;
   };
-  for (int i = 0; i < nc; ++i) {
+  // A barrier answer (InnerResult::barrier > 0) is the central point of every row at once:
+  // its stationarity H F + c + Bᵀλ − μ Σ_i g_i / s_i = 0 with s = b − G F differentiates to the
+  // curvature Gᵀ diag(μ / s²) G = Gᵀ diag(z / s) G on H, and the balance rows alone (no active set).
+  const bool barrier = r.barrier > 0.0;
+  if (barrier && coneCount > 0)
+    throw InputError("sensitivity: a barrier answer of a problem with second-order cones (the barrier solver takes linear models only)");
+  if (barrier) {
+    for (int k = 0; k < rowCount; ++k) {
+      const double slack = p.inequalityBound[k] - p.inequality.row(k).dot(F);
+      if (!(slack > 0.0) || !(r.inequalityMultipliers[k] > 0.0))
+        throw InputError("sensitivity: a barrier answer with row " + p.rowNames[static_cast<std::size_t>(k)] +
+                         " not strictly inside (slack " + std::to_string(slack) + ")");
+      m.lagrangianHessian.noalias() += (r.inequalityMultipliers[k] / slack) * p.inequality.row(k).transpose() * p.inequality.row(k);
+    }
+  }
+  for (int i = 0; i < nc && !barrier; ++i) {
     // The contact's rows and cone, as its model laid them out (contact_problem.hpp).
     const int fzRow = p.normalForceRow(i);
     const int rowEnd = p.contactRowStart[static_cast<std::size_t>(i) + 1];

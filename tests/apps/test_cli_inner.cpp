@@ -57,8 +57,10 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
 
   for (const std::string& solver : innerSolverNames()) {  // every registered solver
     const auto out = dir.path() / (solver + ".json");
-    const auto r = test::runMcopt("inner --problems " + test::quoted(file) + " --solver " + solver + " --out " +
-                                  test::quoted(out));
+    // The barrier solver takes linear contact models only (its own test below refuses the report model).
+    const std::string model = solver == "barrier" ? "wrench-cone" : "report";
+    const auto r = test::runMcopt("inner --problems " + test::quoted(file) + " --solver " + solver + " --contact-model " +
+                                  model + " --out " + test::quoted(out));
     INFO(solver << ": " << r.errors);
     CHECK_THAT(r.errors, Contains("4 problems"));
     const Json results = readJson(out)["results"];
@@ -69,7 +71,7 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
     for (std::size_t k = 0; k < problems.size(); ++k) {
       const Json& result = results[k];
       INFO("problem " << k);
-      const ContactProblem p = test::assemble(problems[k], "report");
+      const ContactProblem p = test::assemble(problems[k], model);
       InnerResult expected;
       makeInnerSolver(solver)->solve(p, expected);
       CHECK(result["status"] == toString(expected.status));
@@ -85,7 +87,8 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
       // cold: certified answers agree; a failed one is nobody's optimum and may stop elsewhere.
       if (expected.status != InnerStatus::Failed)
         CHECK(std::abs(result["objective"].get<double>() - expected.objective) <= 1e-6 * (1 + std::abs(expected.objective)));
-      if (std::string(solver) == "active-set") CHECK(result["status"] == (k < 3 ? "optimal" : "infeasible"));
+      if (solver == "active-set" || solver == "barrier") CHECK(result["status"] == (k < 3 ? "optimal" : "infeasible"));
+      CHECK(result["barrier"].get<double>() == (solver == "barrier" && k < 3 ? 1e-3 : 0.0));
       for (const char* key : {"multipliers", "active_set", "iterations", "kkt_residual", "solve_time_us", "balance_slack"})
         CHECK(result.contains(key));
       CHECK(result["balance_slack"].size() == 6);
@@ -93,6 +96,35 @@ TEST_CASE("inner: every solver through the command gives that solver's library a
     }
     if (results[3]["status"] == "infeasible") CHECK(results[3]["balance_slack"][2].get<double>() < -299.0);
   }
+}
+
+TEST_CASE("inner: the barrier solver's μ from --barrier, refused with another solver, a non-positive μ or second-order cones",
+          "[cli][inner][barrier]") {
+  std::mt19937 rng(227);
+  Json input;
+  for (int k = 0; k < 3; ++k) input["problems"].push_back(problemToJson(test::randomProblem(rng, 2, 30)));
+  test::TempDir dir;
+  const auto file = dir.write("problems.json", input.dump());
+  const std::string head = "inner --problems " + test::quoted(file) + " ";
+  const auto r = test::runMcopt(head + "--solver barrier --barrier 0.01 --contact-model pyramid");
+  INFO(r.all());
+  REQUIRE(r.exitCode == 0);
+  for (const Json& result : Json::parse(r.output)["results"]) {
+    CHECK(result["status"] == "optimal");
+    CHECK(result["barrier"].get<double>() == 0.01);
+    CHECK(result["active_set"].empty());
+  }
+  const auto other = test::runMcopt(head + "--solver active-set --barrier 0.01 --contact-model pyramid");
+  CHECK(other.exitCode == 2);
+  CHECK_THAT(other.errors, Contains("--barrier: only the barrier inner solver has a barrier parameter (the solver is active-set)"));
+  const auto zero = test::runMcopt(head + "--solver barrier --barrier 0 --contact-model pyramid");
+  CHECK(zero.exitCode == 2);
+  CHECK_THAT(zero.errors, Contains("--barrier: must be a positive number"));
+  const auto out = dir.path() / "cones.json";
+  const auto cones = test::runMcopt(head + "--solver barrier --contact-model report --out " + test::quoted(out));
+  CHECK(cones.exitCode == 2);
+  CHECK_THAT(cones.errors, Contains("second-order friction cones") && Contains("pyramid or wrench-cone"));
+  CHECK_FALSE(std::filesystem::exists(out));
 }
 
 TEST_CASE("inner: contact models, warm start on and off, standard output", "[cli][inner]") {

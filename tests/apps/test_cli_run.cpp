@@ -771,6 +771,24 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
        {"inner.solver: unknown inner solver 'qpoases'"}},
       {"inner polishing not a flag", [](YAML::Node& r) { r["inner"]["polish"] = "sometimes"; },
        {"inner.polish: expected true or false"}},
+      {"a barrier parameter for another inner solver", [](YAML::Node& r) { r["inner"]["barrier"] = 1e-3; },
+       {"inner.barrier: only the barrier inner solver has a barrier parameter (the solver is active-set)"}},
+      {"a barrier parameter not positive", [](YAML::Node& r) {
+         r["inner"]["solver"] = "barrier";
+         r["inner"]["contact_model"] = "wrench-cone";
+         r["inner"]["barrier"] = 0.0;
+       }, {"inner.barrier: must be positive"}},
+      {"the barrier solver on second-order cones", [](YAML::Node& r) {
+         r["inner"]["solver"] = "barrier";
+         r["inner"]["contact_model"] = "report";
+       }, {"inner.solver: the barrier inner solver smooths linear contact models only (pyramid, wrench-cone)",
+           "the report model (inner.contact_model) has second-order friction cones"}},
+      {"the barrier solver on a point hand", [](YAML::Node& r) {
+         r["inner"]["solver"] = "barrier";
+         r["inner"]["contact_model"] = "wrench-cone";
+         r["contacts"].push_back(YAML::Load("{surface: r_hand, model: point}"));
+       }, {"inner.solver: the barrier inner solver smooths linear contact models only",
+           "contact 'r_hand' has the point model, with a second-order friction cone"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},
@@ -1069,7 +1087,7 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
     root["samples"] = 8;
     root["hessian"] = "limited-memory";
   }, "weight_shift.yaml");
-  for (const char* solver : {"slsqp", "active-set"}) {
+  for (const char* solver : {"slsqp", "active-set", "barrier"}) {
     const auto out = dir.path() / solver;
     const auto r = test::runMcopt("run " + test::quoted(scenario) + " --contact-forces bilevel --inner-solver " + solver +
                                   " --out " + test::quoted(out) + " --max-iterations 0 --configuration-optimisation off");
@@ -1077,6 +1095,17 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
     REQUIRE(r.exitCode == 4);
     CHECK(readJson(out / "result.json")["inner"]["solver"] == solver);
   }
+  // The barrier solver on the report model's cones: refused before anything runs.
+  const auto report = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["inner"]["contact_model"] = "report";
+  }, "weight_shift_report.yaml");
+  const auto onCones = test::runMcopt("run " + test::quoted(report) + " --inner-solver barrier --out " +
+                                      test::quoted(dir.path() / "refused") + " --max-iterations 0");
+  CHECK(onCones.exitCode == 2);
+  CHECK_THAT(onCones.errors, Contains("--inner-solver: the barrier inner solver smooths linear contact models only") &&
+                                 Contains("the report model (inner.contact_model)"));
+  CHECK_FALSE(std::filesystem::exists(dir.path() / "refused"));
   // inner.polish reaches the inner solver: SLSQP's answers polished on their active sets
   // (docs/theory/inner-problem.md, "Polishing"), counted per iteration; never the active-set method's.
   for (const bool polish : {false, true}) {

@@ -245,6 +245,32 @@ TEST_CASE("a multi-contact motion's exact gradient (per-sample dense KKT) alloca
   }
 }
 
+TEST_CASE("a multi-contact motion's gradient through the barrier inner solver allocates nothing once warm",
+          "[sensitivity][allocation][barrier]") {
+  const HalfSitting hs;
+  for (const char* modelName : {"wrench-cone", "pyramid"}) {
+    for (const int contacts : {2, 3, 4}) {
+      MultiContactSettings settings = hs.settings({modelName, contacts, true});
+      settings.solverName = "barrier";
+      MultiContactGradientEvaluator evaluator(hs.model, hs.actuators, SampledTrajectory(hs.parametrization, 60),
+                                              hs.first(contacts), settings);
+      Eigen::VectorXd x = hs.parametrization.constantMotion(hs.posture);
+      MultiContactResult result;
+      MultiContactGradient gradient;
+      evaluator.evaluate(x, 1.5, result, gradient);  // set-up: the first answers come from the exact solver
+      std::mt19937 rng(7);
+      x += test::randomVector(rng, x.size(), 0.01);
+      Measured measured;
+      evaluator.evaluate(x, 1.5, result, gradient);  // warm: Newton steps from the previous central points
+      const long during = measured.count();
+      INFO(modelName << ", " << contacts << " contacts");
+      CHECK(during == 0);
+      CHECK(result.failedSamples == 0);
+      CHECK(gradient.samplesWithoutDerivative == 0);
+    }
+  }
+}
+
 TEST_CASE("a multi-contact motion's exact gradient with per-sample KLU allocates nothing while the patterns hold",
           "[sensitivity][allocation]") {
   // KLU keeps each sample's analysis and numeric object (sparse_kkt_factor.hpp): at an

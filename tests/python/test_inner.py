@@ -34,6 +34,14 @@ def motion_problems(hrp2, model, count=6):
 def test_solvers_equal_the_cli(mcopt_exe, hrp2, tmp_path, solver, model):
     problems = motion_problems(hrp2, model)
     write_json(tmp_path / "problems.json", {"problems": [p.to_dict() for p in problems]})
+    if solver == "barrier" and model == "report":  # linear contact models only: refused alike, by name
+        message = cli_error(mcopt_exe, "inner", "--problems", tmp_path / "problems.json", "--solver", solver,
+                            "--contact-model", model, "--out", tmp_path / "out.json")
+        assert "second-order friction cones" in message and "pyramid or wrench-cone" in message
+        assert not (tmp_path / "out.json").exists()
+        with pytest.raises(mcopt.InputError, match="second-order friction cones"):
+            mcopt.InnerSolver(solver).solve(problems[0])
+        return
     code, _, _ = run_cli(mcopt_exe, "inner", "--problems", tmp_path / "problems.json", "--solver", solver,
                          "--contact-model", model, "--sensitivity", "--out", tmp_path / "out.json", check=False)
     cli = json.loads((tmp_path / "out.json").read_text())
@@ -194,7 +202,7 @@ def test_bad_types_and_names_raise(hrp2):
         mcopt.InnerProblem(**data, contact_model="cone")
     with pytest.raises(mcopt.InputError, match="only the pyramid contact model has facets"):
         mcopt.InnerProblem(**data, pyramid_facets=6)
-    with pytest.raises(mcopt.InputError, match="expected active-set, slsqp, ipopt, auglag-mma or auglag-lbfgs; got 'simplex'"):
+    with pytest.raises(mcopt.InputError, match="expected active-set, slsqp, ipopt, barrier, auglag-mma or auglag-lbfgs; got 'simplex'"):
         mcopt.InnerSolver("simplex")
     d = mcopt.Dynamics(hrp2, "r_sole")
     with pytest.raises(ValueError, match="unknown contact surface 'foot'"):

@@ -41,14 +41,26 @@ TEST_CASE("multi-contact torque, wrench and energy gradients match central diffe
   const MotionParametrization parametrization(hrp2.robot.jointCount());
   const int samples = 12;
   std::mt19937 rng(401);
+  // The active-set solver's exact optima with either backend, and the barrier solver's central
+  // points (wrench-cone model: the barrier takes linear models) through their own KKT system.
+  struct Variant {
+    KktBackend backend;
+    const char* solver;
+  };
   for (int contactCount : {2, 3, 4}) {
-    for (KktBackend backend : {KktBackend::Dense, KktBackend::SparseKlu}) {
+    for (const Variant variant : {Variant{KktBackend::Dense, "active-set"}, Variant{KktBackend::SparseKlu, "active-set"},
+                                  Variant{KktBackend::Dense, "barrier"}}) {
+      const KktBackend backend = variant.backend;
       SensitivitySettings sensitivity;
       sensitivity.backend = backend;
+      MultiContactSettings settings;
+      settings.solverName = variant.solver;
+      if (settings.solverName == "barrier") settings.problem.model = makeContactModel("wrench-cone");
       const auto contacts = hrp2.contacts(contactCount);
       MultiContactGradientEvaluator gradientEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, samples),
-                                                      contacts, {}, sensitivity);
-      MultiContactEvaluator valueEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, samples), contacts);
+                                                      contacts, settings, sensitivity);
+      MultiContactEvaluator valueEvaluator(model, hrp2.actuators, SampledTrajectory(parametrization, samples), contacts,
+                                           settings);
       // Half-sitting, the legs still (both soles flat where they stand), the upper body moving.
       Eigen::VectorXd x = parametrization.constantMotion(hrp2.halfSitting);
       const Eigen::VectorXd motion = test::randomVector(rng, parametrization.parameterCount(), 0.2);
@@ -62,7 +74,8 @@ TEST_CASE("multi-contact torque, wrench and energy gradients match central diffe
       gradientEvaluator.evaluate(x, duration, result, gradient);
       REQUIRE(result.failedSamples == 0);
       REQUIRE(result.infeasibleSamples == 0);
-      INFO(contactCount << " contacts, " << toString(backend) << ": " << gradient.degenerateSamples << " degenerate samples");
+      INFO(contactCount << " contacts, " << variant.solver << ", " << toString(backend) << ": " << gradient.degenerateSamples
+                        << " degenerate samples");
       // The value side agrees with the plain evaluator.
       valueEvaluator.evaluate(x, duration, moved);
       CHECK((moved.motion.tau - result.motion.tau).cwiseAbs().maxCoeff() <= 1e-9);
