@@ -7,6 +7,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <algorithm>
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -67,9 +68,19 @@ int runCase(const StudyFolder& folder, std::size_t k, const std::filesystem::pat
   const char* arrayTask = std::getenv("SLURM_ARRAY_TASK_ID");
   if (arrayJob && arrayTask) record.slurmJob = std::string(arrayJob) + "_" + arrayTask;
   writeCaseRecord(folder, k, record);
+  // An earlier attempt's result (a timed-out or stopped run's last iterate) is kept beside the
+  // new one, never overwritten: result.attempt-N holds attempt N's.
+  std::string kept;
+  if (previous && std::filesystem::exists(folder.resultFolder(k))) {
+    const std::filesystem::path aside =
+        folder.caseFolder(k) / ("result.attempt-" + std::to_string(std::max(previous->attempts, 1)));
+    std::filesystem::remove_all(aside);
+    std::filesystem::rename(folder.resultFolder(k), aside);
+    kept = "; attempt " + std::to_string(std::max(previous->attempts, 1)) + "'s result kept in " + aside.filename().string();
+  }
   {
     std::ofstream log(folder.logFile(k), std::ios::app);
-    log << "=== case " << k << ", attempt " << record.attempts << " on " << record.host << ", " << now() << "\n";
+    log << "=== case " << k << ", attempt " << record.attempts << " on " << record.host << ", " << now() << kept << "\n";
   }
 
   SpawnOptions options;

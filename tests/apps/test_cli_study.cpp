@@ -200,6 +200,15 @@ TEST_CASE("study: a case past its time limit is stopped, keeps its last iterate 
   CHECK(caseRecord(out, 0)["end"] == "timeout");
   CHECK(caseRecord(out, 0)["seconds"].get<double>() < 2.0 + 5.0);
   CHECK(resultStatus(out, 0) == "interrupted");
+  // A restart runs the case again and keeps the first attempt's iterate beside the new one.
+  const std::string first = fileText(out / "cases/0000/result/result.json");
+  const auto again = test::runMcopt("study " + test::quoted(sweep) + " --out " + test::quoted(out));
+  INFO(again.all());
+  CHECK(again.exitCode == 1);
+  CHECK(caseRecord(out, 0)["attempts"] == 2);
+  CHECK(fileText(out / "cases/0000/result.attempt-1/result.json") == first);
+  CHECK(resultStatus(out, 0) == "interrupted");
+  CHECK_THAT(fileText(out / "cases/0000/run.log"), Contains("attempt 2 on") && Contains("attempt 1's result kept in result.attempt-1"));
 }
 
 #ifdef MCOPT_HAVE_SLURM
