@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The bundled scenarios' neighbours converge with the bundled settings (issue 46,
-// docs/benchmarks/index.md, "Neighbours of the bundled scenarios"): the kick's sweep of
-// scenarios/studies/ at a reduced size (tests/apps/sweeps/, 12 cases, fewer samples), run by
-// `mcopt study` as a user runs it, every case optimal. The reduced sweep's values are values of
-// the bundled sweep it reduces, so that the two cannot drift apart. The throws and the weight
-// shifts are not here: their bilevel families do not yet converge everywhere (the docs list
-// the cases and the cause).
+// docs/benchmarks/index.md, "Neighbours of the bundled scenarios"): the kick's and the throw's
+// sweeps of scenarios/studies/ at a reduced size (tests/apps/sweeps/, 12 cases each, fewer
+// samples), run by `mcopt study` as a user runs it, every case optimal. The reduced sweep's
+// values are values of the bundled sweep it reduces, so that the two cannot drift apart. The
+// throws here are the releases at 1.0 and 1.2 s, every distance and both sides; the 1.4 s
+// releases to far targets and the weight shifts' outer band are where the full sweeps still
+// fail (the edge of admissibility; the docs list the cases and the cause).
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -93,5 +94,13 @@ void requireNeighboursOptimal(const std::string& reduced, const std::string& bun
 TEST_CASE("neighbours: 12 kicks of other durations and toe speeds end optimal with the bundled settings", "[cli][neighbours]") {
   if (test::kUnderSanitizers) return;
   requireNeighboursOptimal("kick_neighbours_small.yaml", "kick_durations.yaml");
+}
+
+// The bundled throw takes the barrier inner solver; with the exact optima of the active-set
+// solver, 3 of 10 throws on 21 samples cycled at kinks of the criterion (lab notes,
+// neighbours-and-stage-one.md). About 3 minutes with one case at a time.
+TEST_CASE("neighbours: 12 throws of other releases and targets end optimal with the bundled settings", "[cli][neighbours]") {
+  if (test::kUnderSanitizers) return;
+  requireNeighboursOptimal("throw_neighbours_small.yaml", "throw_neighbours.yaml");
 }
 
