@@ -38,6 +38,19 @@ ContactProblem moved(test::RandomProblem r, const std::string& model, int which,
   return test::assemble(r, model);
 }
 
+/// Trial k of a seeded family: two to four contacts on 30 joints (so that F is unique), the
+/// wrench cone and the pyramid in turn.
+struct LinearTrial {
+  std::string model;
+  test::RandomProblem data;
+  ContactProblem problem;
+};
+LinearTrial linearTrial(std::mt19937& rng, int trial) {
+  LinearTrial t{trial % 2 == 0 ? "wrench-cone" : "pyramid", test::randomProblem(rng, 2 + trial % 3, 30), {}};
+  t.problem = test::assemble(t.data, t.model);
+  return t;
+}
+
 }  // namespace
 
 TEST_CASE("barrier: the central point at μ, within rows × μ of the exact optimum, tending to it as μ falls",
@@ -46,9 +59,9 @@ TEST_CASE("barrier: the central point at μ, within rows × μ of the exact opti
   auto exact = makeActiveSetSolver();
   int checked = 0;
   for (int trial = 0; trial < 30; ++trial) {
-    const std::string model = trial % 2 == 0 ? "wrench-cone" : "pyramid";
-    const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = test::assemble(r, model);
+    const LinearTrial t = linearTrial(rng, trial);
+    const std::string& model = t.model;
+    const ContactProblem& p = t.problem;
     const InnerResult reference = solved(*exact, p);
     REQUIRE(reference.status == InnerStatus::Optimal);
     const double rows = static_cast<double>(p.inequality.rows());
@@ -91,9 +104,10 @@ TEST_CASE("barrier: dF/dτ0 and dF/dW agree with central differences, across the
   auto barrier = makeBarrierSolver(barrierSettings(1e-2));
   int checked = 0;
   for (int trial = 0; trial < 16; ++trial) {
-    const std::string model = trial % 2 == 0 ? "wrench-cone" : "pyramid";
-    const test::RandomProblem r = test::randomProblem(rng, 2 + trial % 3, 30);
-    const ContactProblem p = test::assemble(r, model);
+    const LinearTrial t = linearTrial(rng, trial);
+    const std::string& model = t.model;
+    const test::RandomProblem& r = t.data;
+    const ContactProblem& p = t.problem;
     const InnerResult b = solved(*barrier, p);
     REQUIRE(b.status == InnerStatus::Optimal);
     InnerSensitivity sensitivity;
