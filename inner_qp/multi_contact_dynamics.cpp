@@ -11,6 +11,10 @@
 
 namespace mcopt {
 
+const char* toString(InnerFeasibility feasibility) {
+  return feasibility == InnerFeasibility::Margin ? "margin" : "slack";
+}
+
 void innerObjectiveTerms(const ActuatorSet& actuators, const Eigen::Ref<const Eigen::VectorXd>& velocity,
                          const Eigen::Ref<const Eigen::VectorXd>& acceleration, Eigen::Ref<Eigen::VectorXd> weights,
                          Eigen::Ref<Eigen::VectorXd> linear) {

@@ -21,10 +21,19 @@
 
 namespace mcopt {
 
+/// What the bilevel outer problem holds at each sample so that its inner problem has an
+/// admissible wrench (sensitivity/bilevel_sample.hpp, docs/theory/outer-problem.md):
+///   Slack   φ = ‖s‖²/(m g)² ≤ 0, s the least balance slack (zero on the admissible side);
+///   Margin  the admissibility margin m_ε ≥ 0 (inner_qp/admissibility_margin.hpp), signed and
+///           with a gradient on the boundary; linear contact models only.
+enum class InnerFeasibility { Slack, Margin };
+const char* toString(InnerFeasibility feasibility);
+
 struct MultiContactSettings {
   ContactProblemSettings problem;
   InnerSettings solver;
   std::string solverName = "active-set";  ///< a registered inner solver (innerSolverNames())
+  InnerFeasibility feasibility = InnerFeasibility::Slack;
 };
 
 /// A robot's contact surface as an inner-problem contact (f_min = 0), at `pose` in the world

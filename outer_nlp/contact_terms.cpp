@@ -7,7 +7,9 @@
 //                          kind: contact_unilateral (f_z ≥ f_min), contact_friction, contact_cop,
 //                          contact_yaw;
 //   inner_feasibility      bilevel: the inner problem's least balance slack φ ≤ 0 (the inner
-//                          problem holds the contacts' own rows).
+//                          problem holds the contacts' own rows);
+//   inner_margin           bilevel with inner.feasibility: margin, in the same output: the
+//                          admissibility margin −m_ε ≤ 0 (inner_qp/admissibility_margin.hpp).
 #include <limits>
 #include <ostream>
 
@@ -25,6 +27,7 @@ constexpr ConstraintKindInfo kFriction{"contact_friction", "contact row units (c
 constexpr ConstraintKindInfo kCop{"contact_cop", "contact row units (contact model)"};
 constexpr ConstraintKindInfo kYaw{"contact_yaw", "contact row units (contact model)"};
 constexpr ConstraintKindInfo kInnerFeasibility{"inner_feasibility", "(slack / m g)^2"};
+constexpr ConstraintKindInfo kInnerMargin{"inner_margin", "-margin / (m g)"};
 
 /// detail: the row's index among every contact's rows (SampleOutputs::contactRowStart).
 class ContactAdmissibilityTerm final : public ConstraintTerm {
@@ -81,12 +84,16 @@ class ContactAdmissibilityTerm final : public ConstraintTerm {
 
 class InnerFeasibilityTerm final : public SampleTermOfOneKind {
  public:
-  explicit InnerFeasibilityTerm(const TermContext& c) : SampleTermOfOneKind(kInnerFeasibility), c_(c) {}
+  explicit InnerFeasibilityTerm(const TermContext& c)
+      : SampleTermOfOneKind(c.scenario.inner.feasibility == InnerFeasibility::Margin ? kInnerMargin : kInnerFeasibility), c_(c) {}
   void appendRows(RowSink& sink) const override {
     if (c_.bilevel) sink.outputRow(0, c_.outputs.infeasibility(), c_.allJoints, false);
   }
   void bounds(int, int, double& lower, double& upper) const override { lower = -kInf, upper = 0.0; }
-  void subject(int, int, std::ostream& name) const override { name << "inner problem feasibility (balance slack)"; }
+  void subject(int, int, std::ostream& name) const override {
+    name << (c_.scenario.inner.feasibility == InnerFeasibility::Margin ? "inner problem admissibility margin"
+                                                                        : "inner problem feasibility (balance slack)");
+  }
 
  private:
   TermContext c_;

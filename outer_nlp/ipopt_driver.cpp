@@ -45,8 +45,9 @@ constexpr const char* kIpoptMessages[] = {
     "Invalid option",
     "Not enough memory",
     "Internal error",
+    "Stage stalled (stopped by mcopt)",
 };
-static_assert(std::size(kIpoptMessages) == static_cast<std::size_t>(OuterStatus::InternalError) + 1);
+static_assert(std::size(kIpoptMessages) == static_cast<std::size_t>(OuterStatus::Stalled) + 1);
 
 OuterStatus fromIpopt(Ipopt::SolverReturn status) {
   switch (status) {

@@ -1,12 +1,31 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "outer_nlp/motion_solve.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <optional>
 
 #include "core/errors.hpp"
 
 namespace mcopt {
+
+StageStallWatch::StageStallWatch(Settings settings) : settings_(settings) {
+  if (settings_.window < 2) throw InputError("stage stall watch: the window needs at least 2 iterations");
+  objectives_.assign(static_cast<std::size_t>(settings_.window), 0.0);
+}
+
+bool StageStallWatch::stalled(const IterationReport& r) {
+  if (r.iterate == nullptr || !(r.violation <= settings_.violation) || !std::isfinite(r.objective)) {
+    recorded_ = 0;
+    return false;
+  }
+  objectives_[static_cast<std::size_t>(recorded_ % settings_.window)] = r.objective;
+  ++recorded_;
+  if (recorded_ < settings_.window) return false;
+  const auto [low, high] = std::minmax_element(objectives_.begin(), objectives_.end());
+  return *high - *low <= settings_.relativeChange * std::max(1.0, std::abs(r.objective));
+}
 
 MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, const Eigen::VectorXd& x0,
                                const OuterSolverSettings& settings, const MotionSolveEvents& events) {
@@ -80,9 +99,20 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
             epigraph ? 1e-6 : 1e-4,
             stage.rounds > 0 ? "torque-limit screening: " : k > 0 ? "continuation stage: " : "--start-from: "};
       }
+      // A stage before the scenario's own problem hands on once it stalls (StageStallWatch).
+      StageStallWatch watch;
+      bool stalled = false;
       outcome = solveOuter(current, x, roundSettings, [&](const IterationReport& r) {
+        if (!last && watch.stalled(r)) {
+          stalled = true;
+          return false;
+        }
         return !events.onIteration || events.onIteration(k, current, r);
       });
+      if (stalled && outcome.status == OuterStatus::Interrupted) {
+        outcome.status = OuterStatus::Stalled;
+        outcome.message = "the stage's criterion stopped moving; its iterate is handed on";
+      }
       closureAngles = current.closureAngles();
       ++stage.rounds;
       stage.iterations += outcome.iterations;

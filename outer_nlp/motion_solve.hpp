@@ -51,6 +51,32 @@ struct MotionSolveOutcome {
   std::string reason;               ///< why the solve ended before the scenario's own problem, if it did
 };
 
+/// Whether a stage before the scenario's own problem has stopped making progress
+/// (docs/theory/outer-problem.md, "Continuation"): over the last `window` regular iterations
+/// its criterion moved by at most `relativeChange` × max(1, |f|) while every iterate held its
+/// rows to `violation`. Such a stage hands its iterate on (status `stalled`) instead of
+/// running to its iteration limit: a stage whose Hessian model lacks a curvature the optimum
+/// needs can circle there for hundreds of iterations (measured on the throw with the margin
+/// row, docs/developers/lab-notes/admissibility-margin.md). Restoration iterates (another
+/// problem's) restart the window.
+class StageStallWatch {
+ public:
+  struct Settings {
+    int window = 25;
+    double relativeChange = 1e-6;
+    double violation = 1e-6;
+  };
+  StageStallWatch() : StageStallWatch(Settings{}) {}
+  explicit StageStallWatch(Settings settings);
+  /// Records one iteration; true once the stage has stalled.
+  bool stalled(const IterationReport& report);
+
+ private:
+  Settings settings_;
+  std::vector<double> objectives_;  ///< the window, a ring
+  int recorded_ = 0;                ///< regular iterations in a row, with the violation held
+};
+
 /// `problem` is the scenario's own (full) motion problem; x0 its starting point. Continuation
 /// stages for other contact-force formulations than the scenario's are left out.
 MotionSolveOutcome solveMotion(const Scenario& scenario, MotionProblem& problem, const Eigen::VectorXd& x0,

@@ -17,8 +17,8 @@ constexpr const char* kStatusNames[] = {
     "running",          "optimal",   "acceptable",         "maximum_iterations",        "maximum_cpu_time",
     "tiny_step",        "infeasible", "interrupted",       "feasible_point_found",      "diverging",
     "restoration_failed", "error_in_step_computation", "invalid_number", "too_few_degrees_of_freedom",
-    "invalid_option",   "out_of_memory", "internal_error"};
-static_assert(std::size(kStatusNames) == static_cast<std::size_t>(OuterStatus::InternalError) + 1);
+    "invalid_option",   "out_of_memory", "internal_error", "stalled"};
+static_assert(std::size(kStatusNames) == static_cast<std::size_t>(OuterStatus::Stalled) + 1);
 
 using OuterSolverFactory = std::unique_ptr<OuterSolver> (*)();
 

@@ -27,7 +27,10 @@ namespace mcopt {
 enum class OuterStatus {
   Running, Optimal, Acceptable, MaximumIterations, MaximumCpuTime, TinyStep, Infeasible, Interrupted,
   FeasiblePointFound, Diverging, RestorationFailed, ErrorInStepComputation, InvalidNumber, TooFewDegreesOfFreedom,
-  InvalidOption, OutOfMemory, InternalError
+  InvalidOption, OutOfMemory, InternalError,
+  /// A continuation stage stopped by us because its criterion stopped moving (StageStallWatch,
+  /// motion_solve.hpp); the next stage starts from its iterate. Never a run's final status.
+  Stalled
 };
 /// "running", "optimal", "acceptable", "maximum_iterations", … (docs/reference/results.md, "Results").
 const char* toString(OuterStatus status);

@@ -440,6 +440,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     const YAML::Node inner = root["inner"];
     throw InputError(where(file, inner["contact_model"] ? inner["contact_model"] : inner["solver"], "inner.solver") + why);
   }
+  if (const std::string why = marginModelRefusal(s); !why.empty())
+    throw InputError(where(file, root["inner"]["feasibility"], "inner.feasibility") + why);
   return s;
 }
 

@@ -150,6 +150,9 @@ std::string exactHessianRefusal(const Scenario& scenario);
 /// Why the scenario's contact models do not suit its inner solver (empty when they do): the
 /// barrier solver smooths linear models only (inner.contact_model and every contacts[k].model).
 std::string barrierModelRefusal(const Scenario& scenario);
+/// Why the scenario's contact models do not suit inner.feasibility: margin (empty when they do):
+/// the margin shifts linear rows, and a second-order cone has none.
+std::string marginModelRefusal(const Scenario& scenario);
 
 
 /// Reads and validates a scenario file (robot files are loaded relative to it). Throws

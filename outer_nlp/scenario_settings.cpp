@@ -43,7 +43,7 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
 }
 
 void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
-  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish", "barrier"});
+  yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish", "barrier", "feasibility"});
   if (node["solver"]) {
     const std::string name = yaml::text(file, node["solver"], "inner.solver");
     if (!isInnerSolverName(name))
@@ -77,6 +77,12 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
       throw InputError(where(file, node["barrier"], "inner.barrier") + "only the barrier inner solver has a barrier parameter (the solver is " +
                        s.inner.solverName + ")");
     s.inner.solver.barrier = yaml::positive(file, node["barrier"], "inner.barrier");
+  }
+  if (node["feasibility"]) {
+    const std::string name = yaml::text(file, node["feasibility"], "inner.feasibility");
+    if (name == "margin") s.inner.feasibility = InnerFeasibility::Margin;
+    else if (name == "slack") s.inner.feasibility = InnerFeasibility::Slack;
+    else throw InputError(where(file, node["feasibility"], "inner.feasibility") + "expected slack or margin, got '" + name + "'");
   }
   if (node["kkt_backend"]) {
     try {
@@ -163,15 +169,28 @@ bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
          stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
 }
 
-std::string barrierModelRefusal(const Scenario& s) {
-  if (s.inner.solverName != "barrier") return {};
-  const std::string head = "the barrier inner solver smooths linear contact models only (pyramid, wrench-cone): ";
+namespace {
+/// Which contact model of the scenario has a second-order cone (empty: none).
+std::string secondOrderConeModel(const Scenario& s) {
   if (s.inner.problem.model->hasSecondOrderCone())
-    return head + "the " + s.inner.problem.model->name() + " model (inner.contact_model) has second-order friction cones";
+    return "the " + s.inner.problem.model->name() + " model (inner.contact_model) has second-order friction cones";
   for (const auto& [contact, model] : s.inner.problem.byContact)
     if (model->hasSecondOrderCone())
-      return head + "contact '" + contact + "' has the " + model->name() + " model, with a second-order friction cone";
+      return "contact '" + contact + "' has the " + model->name() + " model, with a second-order friction cone";
   return {};
+}
+}  // namespace
+
+std::string barrierModelRefusal(const Scenario& s) {
+  if (s.inner.solverName != "barrier") return {};
+  const std::string cone = secondOrderConeModel(s);
+  return cone.empty() ? cone : "the barrier inner solver smooths linear contact models only (pyramid, wrench-cone): " + cone;
+}
+
+std::string marginModelRefusal(const Scenario& s) {
+  if (s.inner.feasibility != InnerFeasibility::Margin) return {};
+  const std::string cone = secondOrderConeModel(s);
+  return cone.empty() ? cone : "inner.feasibility: margin shifts the rows of linear contact models only (pyramid, wrench-cone): " + cone;
 }
 
 }  // namespace mcopt

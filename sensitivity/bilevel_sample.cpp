@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "sensitivity/bilevel_sample.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "core/errors.hpp"
 
 namespace mcopt {
@@ -22,6 +25,18 @@ BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurf
   for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
   // Room for the largest active set, so that warm starts copy without allocating.
   result_.activeSet.reserve(static_cast<std::size_t>(sample_.problem.inequality.rows()) + sample_.problem.cones.size());
+  if (settings.feasibility == InnerFeasibility::Margin) {
+    // Moments in units of m g ℓ, ℓ the largest half-extent of the sample's contact rectangles.
+    double length = 0.0;
+    for (const ContactSurface& c : contacts_)
+      length = std::max({length, std::abs(c.xMin), std::abs(c.xMax), std::abs(c.yMin), std::abs(c.yMax)});
+    MarginSettings marginSettings;
+    marginSettings.weight = weight;
+    if (length > 0.0) marginSettings.length = length;
+    margin_ = std::make_unique<AdmissibilityMargin>(sample_.problem, marginSettings);
+    marginResult_.activeSet.reserve(static_cast<std::size_t>(sample_.problem.inequality.rows()) + 1);
+    marginResult_.wrenches.setZero(variables);
+  }
 }
 
 BilevelSample::~BilevelSample() = default;
@@ -38,6 +53,7 @@ void BilevelSample::warmStartFrom(const BilevelSample& other) {
   result_.coneMultipliers = other.result_.coneMultipliers;
   result_.balanceMultipliers = other.result_.balanceMultipliers;
   result_.barrier = other.result_.barrier;
+  if (margin_ && other.margin_) marginResult_.activeSet = other.marginResult_.activeSet;
 }
 
 void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives* d,
@@ -51,10 +67,13 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
   const Eigen::MatrixXd& J1 = sample_.wrenchToTorque;
   torque_ = data.tau;
   torque_.noalias() -= J1 * result_.wrenches;
-  // φ at the least-slack phase's point: the function whose derivative the envelope theorem gives.
+  // The row: −m_ε (margin), or φ at the least-slack phase's point, the function whose
+  // derivative the envelope theorem gives.
   const bool infeasible = result_.status == InnerStatus::Infeasible;
   if (infeasible) leastSlack_.noalias() = data.referenceWrench - sample_.problem.balance * result_.leastSlackWrenches;
-  infeasibility_ = infeasible ? scale_ * leastSlack_.squaredNorm() : 0.0;
+  if (margin_) margin_->solve(sample_.problem, marginResult_);
+  const bool byMargin = margin_ && marginResult_.solved;
+  infeasibility_ = byMargin ? -marginResult_.margin : infeasible ? scale_ * leastSlack_.squaredNorm() : 0.0;
   hasWrenchDerivative_ = false;
   if (!withDerivatives) return;
 
@@ -67,18 +86,12 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
     dJ1Fdq_ += dTorque_;
     dBFdq_ += dWorld_;
   }
-  // φ = ‖s‖²/(m g)², s = W0 − B F: the envelope theorem's derivative (header), at the
-  // least-slack phase's own minimiser.
-  if (result_.status == InnerStatus::Infeasible) {
-    dLeastSlackBFdq_.setZero();
-    for (int i = 0; i < nc; ++i) {
-      const Vector6 wrench = sample_.problem.contactWrench(result_.leastSlackWrenches, i);
-      wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
-      dLeastSlackBFdq_ += dWorld_;
-    }
-    dInfeasibilityDq_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * (d->dwrenchDq - dLeastSlackBFdq_);
-    dInfeasibilityDv_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * d->dwrenchDv;
-    dInfeasibilityDa_.noalias() = (2.0 * scale_) * leastSlack_.transpose() * d->dwrenchDa;
+  // The row's derivative (header): −λᵀ (∂W0/∂x − ∂(B F)/∂x) at the margin's maximiser, or
+  // φ's 2 sᵀ (∂W0/∂x − ∂(B F)/∂x)/(m g)² at the least-slack phase's own minimiser.
+  if (byMargin) {
+    balanceRowDerivative(model, data, *d, marginResult_.wrenches, marginResult_.balanceGradient, -1.0);
+  } else if (infeasible) {
+    balanceRowDerivative(model, data, *d, result_.leastSlackWrenches, leastSlack_, 2.0 * scale_);
   } else {
     dInfeasibilityDq_.setZero(), dInfeasibilityDv_.setZero(), dInfeasibilityDa_.setZero();
   }
@@ -119,6 +132,19 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
   fixedDv_ = d->dtauDv;
   fixedDa_ = d->dtauDa;
   updateTorqueDerivatives();
+}
+
+void BilevelSample::balanceRowDerivative(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives& d,
+                                         const Eigen::VectorXd& wrenches, const Vector6& c, double factor) {
+  dLeastSlackBFdq_.setZero();
+  for (int i = 0; i < contactCount(); ++i) {
+    const Vector6 wrench = sample_.problem.contactWrench(wrenches, i);
+    wrenchMapDerivatives(model, data, sample_.frames[static_cast<std::size_t>(i)], wrench, dWorld_, dTorque_);
+    dLeastSlackBFdq_ += dWorld_;
+  }
+  dInfeasibilityDq_.noalias() = factor * c.transpose() * (d.dwrenchDq - dLeastSlackBFdq_);
+  dInfeasibilityDv_.noalias() = factor * c.transpose() * d.dwrenchDv;
+  dInfeasibilityDa_.noalias() = factor * c.transpose() * d.dwrenchDa;
 }
 
 void BilevelSample::setWrenchDerivative(const Eigen::Ref<const Eigen::MatrixXd>& dF) {

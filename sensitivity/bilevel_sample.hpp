@@ -18,6 +18,15 @@
 // (the inner KKT system is that of the shifted balance), so dF*/dx is taken as zero and the
 // sample is counted: Ipopt is steered by φ, never by a silent zero.
 //
+// With InnerFeasibility::Margin the row is instead −m_ε, the admissibility margin of the sample's
+// contacts (inner_qp/admissibility_margin.hpp) held ≤ 0: signed, C¹, and with the derivative
+//     ∂(−m_ε)/∂x = −λᵀ (∂W0/∂x − ∂(B F)/∂x |_{F = F_m})
+// (λ its balance multiplier, F_m its maximiser), nonzero on the boundary where φ's vanishes.
+// It does not depend on the inner solution: the wrenches and Γ are those of the inner problem
+// as before. Should the margin's QP not end optimal (only its iteration limit could stop it:
+// it is strictly convex and always feasible), the sample's row is φ's, an exact feasibility
+// row as well.
+//
 // Model/data: the contacts, settings and solver choice are fixed at construction; every
 // buffer is sized then, and evaluate() allocates nothing once the solver has seen a problem.
 
@@ -27,6 +36,7 @@
 
 #include "core/actuators.hpp"
 #include "core/dynamics_derivatives.hpp"
+#include "inner_qp/admissibility_margin.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
 #include "sensitivity/inner_sensitivity.hpp"
 
@@ -68,7 +78,8 @@ class BilevelSample {
 
   const InnerResult& innerResult() const { return result_; }
   const SampleProblem& problem() const { return sample_; }
-  /// Γ = Γ0 − J1 F* (n), φ (scalar), and with derivatives n × n blocks and 1 × n rows.
+  /// Γ = Γ0 − J1 F* (n), the feasibility row (φ, or −m_ε with the margin; ≤ 0 when feasible),
+  /// and with derivatives n × n blocks and 1 × n rows.
   const Eigen::VectorXd& torque() const { return torque_; }
   double infeasibility() const { return infeasibility_; }
   const Eigen::MatrixXd& torqueDq() const { return dTorqueDq_; }
@@ -90,6 +101,8 @@ class BilevelSample {
   std::unique_ptr<InnerSolver> solver_;
   InnerSensitivity sensitivity_;
   InnerResult result_;
+  std::unique_ptr<AdmissibilityMargin> margin_;  ///< null: the slack row φ
+  MarginResult marginResult_;
   SensitivityDiagnostics diagnostics_;
   bool hasWrenchDerivative_ = false;
   double infeasibility_ = 0.0;
@@ -100,6 +113,10 @@ class BilevelSample {
   Eigen::MatrixXd fixedDq_, fixedDv_, fixedDa_;  ///< ∂Γ/∂x at fixed wrenches
   Eigen::Matrix<double, 6, Eigen::Dynamic> dBFdq_, dLeastSlackBFdq_, dWorld_, dTorqueT_, dWorldT_;
   Vector6 leastSlack_ = Vector6::Zero();
+  /// The row's derivative from a balance-space covector `c` at wrenches `wrenches`:
+  /// factor · cᵀ (∂W0/∂x − ∂(B F)/∂x |_F) into dInfeasibilityD*.
+  void balanceRowDerivative(const DynamicsModel& model, const DynamicsData& data, const DynamicsDerivatives& d,
+                            const Eigen::VectorXd& wrenches, const Vector6& c, double factor);
   Eigen::RowVectorXd dInfeasibilityDq_, dInfeasibilityDv_, dInfeasibilityDa_;
 };
 

@@ -789,6 +789,18 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
          r["contacts"].push_back(YAML::Load("{surface: r_hand, model: point}"));
        }, {"inner.solver: the barrier inner solver smooths linear contact models only",
            "contact 'r_hand' has the point model, with a second-order friction cone"}},
+      {"an unknown inner feasibility row", [](YAML::Node& r) { r["inner"]["feasibility"] = "penalty"; },
+       {"inner.feasibility: expected slack or margin, got 'penalty'"}},
+      {"the margin row on second-order cones", [](YAML::Node& r) {
+         r["inner"]["contact_model"] = "report";
+         r["inner"]["feasibility"] = "margin";
+       }, {"inner.feasibility: margin shifts the rows of linear contact models only (pyramid, wrench-cone)",
+           "the report model (inner.contact_model) has second-order friction cones"}},
+      {"the margin row with a point hand", [](YAML::Node& r) {
+         r["inner"]["contact_model"] = "wrench-cone";
+         r["inner"]["feasibility"] = "margin";
+         r["contacts"].push_back(YAML::Load("{surface: r_hand, model: point}"));
+       }, {"inner.feasibility: margin shifts the rows", "contact 'r_hand' has the point model"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},

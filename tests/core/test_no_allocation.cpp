@@ -271,6 +271,33 @@ TEST_CASE("a multi-contact motion's gradient through the barrier inner solver al
   }
 }
 
+TEST_CASE("a multi-contact motion's gradient with the admissibility-margin row allocates nothing once warm",
+          "[sensitivity][allocation][margin]") {
+  // inner.feasibility: margin: each sample also solves its margin QP (inner_qp/admissibility_margin.hpp)
+  // and differentiates it, warm from its own last working set.
+  const HalfSitting hs;
+  for (const char* modelName : {"wrench-cone", "pyramid"}) {
+    for (const int contacts : {2, 3}) {
+      MultiContactSettings settings = hs.settings({modelName, contacts, true});
+      settings.feasibility = InnerFeasibility::Margin;
+      MultiContactGradientEvaluator evaluator(hs.model, hs.actuators, SampledTrajectory(hs.parametrization, 60),
+                                              hs.first(contacts), settings);
+      Eigen::VectorXd x = hs.parametrization.constantMotion(hs.posture);
+      MultiContactResult result;
+      MultiContactGradient gradient;
+      evaluator.evaluate(x, 1.5, result, gradient);  // set-up
+      std::mt19937 rng(9);
+      x += test::randomVector(rng, x.size(), 0.01);
+      Measured measured;
+      evaluator.evaluate(x, 1.5, result, gradient);
+      const long during = measured.count();
+      INFO(modelName << ", " << contacts << " contacts");
+      CHECK(during == 0);
+      CHECK(gradient.samplesWithoutDerivative == 0);
+    }
+  }
+}
+
 TEST_CASE("a multi-contact motion's exact gradient with per-sample KLU allocates nothing while the patterns hold",
           "[sensitivity][allocation]") {
   // KLU keeps each sample's analysis and numeric object (sparse_kkt_factor.hpp): at an

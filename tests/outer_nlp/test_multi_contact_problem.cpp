@@ -46,6 +46,40 @@ void addHandContact(Scenario& s, double start, double end) {
 }
 
 
+/// The weight shift made fast and large (0.9 s, free ends, a large perturbation): the two soles
+/// cannot carry it at most samples (tip or slip). `feasibility`: the inner feasibility row.
+Scenario tooFastWeightShift(InnerFeasibility feasibility) {
+  Scenario s = weightShift(12);
+  s.fixStart = s.fixEnd = false;
+  s.duration.initial = s.duration.lower = s.duration.upper = 0.9;
+  s.inner.feasibility = feasibility;
+  return s;
+}
+
+/// The rows' Jacobian against central differences (h = 1e-6): the worst relative error, the
+/// largest finite-difference entry and the smallest exact row's largest entry.
+struct RowDerivativeCheck {
+  double worst = 0.0, largest = 0.0, smallestRow = std::numeric_limits<double>::infinity();
+};
+RowDerivativeCheck rowDerivatives(MotionProblem& problem, Eigen::VectorXd& x, const std::vector<int>& rows) {
+  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
+  const Eigen::MatrixXd fd = test::centralDifferences(x, 1e-6, [&] {
+    Eigen::VectorXd values;
+    problem.constraints(x, values);
+    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t k = 0; k < rows.size(); ++k) out[static_cast<Eigen::Index>(k)] = values[rows[k]];
+    return out;
+  });
+  RowDerivativeCheck c;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Eigen::RowVectorXd exact = jacobian.row(rows[k]), differences = fd.row(static_cast<Eigen::Index>(k));
+    c.worst = std::max(c.worst, ((exact - differences).array().abs() / (1.0 + differences.array().abs())).maxCoeff());
+    c.largest = std::max(c.largest, differences.cwiseAbs().maxCoeff());
+    c.smallestRow = std::min(c.smallestRow, exact.cwiseAbs().maxCoeff());
+  }
+  return c;
+}
+
 }  // namespace
 
 TEST_CASE("multi-contact outer problem: exact derivatives of every formulation", "[outer][multi-contact]") {
@@ -130,10 +164,8 @@ TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact 
 
 TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted and steered by an exact row",
           "[outer][multi-contact]") {
-  // A fast, large motion that the two soles cannot carry at some samples (tip or slip).
-  Scenario s = weightShift(12);
-  s.fixStart = s.fixEnd = false;
-  s.duration.initial = s.duration.lower = s.duration.upper = 0.9;
+  // The slack row φ (the margin is tested below).
+  const Scenario s = tooFastWeightShift(InnerFeasibility::Slack);  // the problem keeps a reference
   MotionProblem problem(s);
   Eigen::VectorXd x = test::perturbedMotion(problem, 0.3, 11);
   Eigen::VectorXd g;
@@ -147,26 +179,42 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
   for (int r = 0; r < problem.constraintCount(); ++r)
     if (problem.rowKind(r) == "inner_feasibility") rows.push_back(r), positive += g[r] > 0.0;
   CHECK(positive == infeasible);
-  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
-  const Eigen::MatrixXd fd = test::centralDifferences(x, 1e-6, [&] {
-    Eigen::VectorXd values;
-    problem.constraints(x, values);
-    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t k = 0; k < rows.size(); ++k) out[static_cast<Eigen::Index>(k)] = values[rows[k]];
-    return out;
-  });
-  double worst = 0.0, largest = 0.0;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const Eigen::RowVectorXd exact = jacobian.row(rows[k]), differences = fd.row(static_cast<Eigen::Index>(k));
-    worst = std::max(worst, ((exact - differences).array().abs() / (1.0 + differences.array().abs())).maxCoeff());
-    largest = std::max(largest, differences.cwiseAbs().maxCoeff());
-  }
-  INFO("φ rows: largest derivative " << largest << ", worst relative error " << worst);
-  CHECK(largest > 1e-6);  // the rows do steer
+  const RowDerivativeCheck c = rowDerivatives(problem, x, rows);
+  INFO("φ rows: largest derivative " << c.largest << ", worst relative error " << c.worst);
+  CHECK(c.largest > 1e-6);  // the rows do steer
   // Measured: ≤ 5e-7 at 8 of the 9 infeasible samples, 2.7e-6 at the one whose least-slack
   // minimiser is weakly determined (the phase-1 Tikhonov term is 1e-9): the envelope
   // theorem's derivative is as exact as phase 1's point. Below 1e-6 is the issue's target.
-  CHECK(worst < 1e-5);
+  CHECK(c.worst < 1e-5);
+}
+
+TEST_CASE("multi-contact outer problem: the admissibility margin rows are signed, exact, and steer on both sides",
+          "[outer][multi-contact][margin]") {
+  // inner.feasibility: margin (inner_qp/admissibility_margin.hpp) on the motion of the test
+  // above: the row −m_ε is positive at every infeasible sample, negative at samples with room,
+  // and — unlike φ, zero with a zero gradient wherever the sample is feasible — every row has a
+  // gradient, exact against central differences.
+  const Scenario s = tooFastWeightShift(InnerFeasibility::Margin);  // the problem keeps a reference
+  MotionProblem problem(s);
+  Eigen::VectorXd x = test::perturbedMotion(problem, 0.3, 11);
+  Eigen::VectorXd g;
+  problem.constraints(x, g);
+  const int infeasible = problem.infeasibleSamples();
+  INFO("infeasible samples " << infeasible);
+  REQUIRE(infeasible > 0);
+  std::vector<int> rows;
+  int positive = 0, negative = 0;
+  for (int r = 0; r < problem.constraintCount(); ++r) {
+    CHECK(problem.rowKind(r) != "inner_feasibility");
+    if (problem.rowKind(r) == "inner_margin") rows.push_back(r), positive += g[r] > 0.0, negative += g[r] < 0.0;
+  }
+  CHECK(positive >= infeasible);  // the margin is conservative by ε/2 ‖F̃‖²: never less
+  CHECK(negative > 0);
+  CHECK(positive + negative == static_cast<int>(rows.size()));
+  const RowDerivativeCheck c = rowDerivatives(problem, x, rows);
+  INFO("margin rows: smallest gradient " << c.smallestRow << ", worst relative error " << c.worst);
+  CHECK(c.smallestRow > 1e-6);  // every row steers
+  CHECK(c.worst < 1e-6);
 }
 
 TEST_CASE("multi-contact outer problem: the contact wrenches balance W0 at every sample", "[outer][multi-contact]") {

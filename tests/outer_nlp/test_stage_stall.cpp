@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: BSD-3-Clause
+// The hand-over of a stalled continuation stage (outer_nlp/motion_solve.hpp, StageStallWatch;
+// docs/theory/outer-problem.md, "Continuation"): a window of regular iterations whose criterion
+// moves by at most its relative change, every one of them feasible; restoration iterates,
+// infeasible ones and steady progress restart or withhold it.
+#include <catch2/catch.hpp>
+
+#include "outer_nlp/motion_solve.hpp"
+
+using namespace mcopt;
+
+namespace {
+
+IterationReport report(double objective, double violation, bool regular = true) {
+  static const Eigen::VectorXd iterate = Eigen::VectorXd::Zero(1);
+  IterationReport r;
+  r.objective = objective, r.violation = violation;
+  r.iterate = regular ? &iterate : nullptr;
+  return r;
+}
+
+/// The iteration (1-based) at which the watch says stalled, or 0.
+int stalledAt(StageStallWatch& watch, const std::vector<IterationReport>& reports) {
+  for (std::size_t k = 0; k < reports.size(); ++k)
+    if (watch.stalled(reports[k])) return static_cast<int>(k) + 1;
+  return 0;
+}
+
+}  // namespace
+
+TEST_CASE("stage stall: a flat feasible window hands on, progress and infeasible or restoration iterates do not",
+          "[outer][continuation]") {
+  const StageStallWatch::Settings settings{10, 1e-6, 1e-6};
+  std::vector<IterationReport> flat;
+  // The throw's plateau: 134.857559 … 134.857581 J, violations 1e-13 … 1e-7.
+  for (int k = 0; k < 40; ++k) flat.push_back(report(134.857559 + (k % 3 == 0 ? 2.2e-5 : 0.0), k % 3 == 0 ? 4e-13 : 9e-8));
+  {
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, flat) == 10);  // as soon as a whole window is recorded
+  }
+  {
+    // Steady progress of 1e-5 relative an iteration: never flat over 10.
+    std::vector<IterationReport> descending;
+    for (int k = 0; k < 100; ++k) descending.push_back(report(100.0 * (1.0 - 1e-5 * k), 1e-9));
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, descending) == 0);
+  }
+  {
+    // A flat criterion with the rows not yet held: not a stall, and the window restarts after it.
+    std::vector<IterationReport> reports = flat;
+    reports[7].violation = 1e-3;
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, reports) == 8 + 10);  // the infeasible 8th, then a new window of 10
+  }
+  {
+    // Restoration iterates (no iterate of this problem) restart the window too.
+    std::vector<IterationReport> reports = flat;
+    reports[5] = report(134.857559, 0.0, false);
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, reports) == 6 + 10);
+  }
+  {
+    // A criterion near zero is compared absolutely (max(1, |f|)): 1e-7 J of noise on 1e-3 J.
+    std::vector<IterationReport> small;
+    for (int k = 0; k < 20; ++k) small.push_back(report(1e-3 + (k % 2) * 1e-7, 0.0));
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, small) == 10);
+  }
+  CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{1, 1e-6, 1e-6}));
+}
