@@ -19,13 +19,17 @@
 // Allocation-free after construction.
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "core/spatial.hpp"
 #include "inner_qp/contact_problem.hpp"
-#include "inner_qp/dual_active_set_qp.hpp"
 
 namespace mcopt {
+
+namespace inner_detail {
+class DualActiveSetQp;
+}
 
 struct MarginSettings {
   double weight = 1.0;            ///< m g [N]: forces are measured in it
@@ -51,6 +55,9 @@ class AdmissibilityMargin {
   /// Sized for the contact set of `layout`; throws InputError when a contact has a
   /// second-order cone or fewer than six wrench variables, or a setting is not positive.
   AdmissibilityMargin(const ContactProblem& layout, MarginSettings settings);
+  ~AdmissibilityMargin();
+  AdmissibilityMargin(AdmissibilityMargin&&) noexcept;
+  AdmissibilityMargin& operator=(AdmissibilityMargin&&) noexcept;
 
   /// The margin of `problem` (the same contact set: sizes are checked). Warm-started from the
   /// active set in `result`.
@@ -62,7 +69,7 @@ class AdmissibilityMargin {
   MarginSettings settings_;
   int variables_ = 0, rows_ = 0;
   Eigen::VectorXd scale_;  ///< S: m g for a force component, m g ℓ for a moment's
-  inner_detail::DualActiveSetQp qp_;
+  std::unique_ptr<inner_detail::DualActiveSetQp> qp_;  ///< the QP in (F̃, t), sized once
 };
 
 }  // namespace mcopt

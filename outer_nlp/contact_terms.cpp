@@ -82,10 +82,16 @@ class ContactAdmissibilityTerm final : public ConstraintTerm {
   TermContext c_;
 };
 
-class InnerFeasibilityTerm final : public SampleTermOfOneKind {
+/// The inner feasibility row: φ (inner_feasibility) or −m_ε (inner_margin), as the scenario's
+/// inner.feasibility says; both kinds registered, one laid out.
+class InnerFeasibilityTerm final : public ConstraintTerm {
  public:
-  explicit InnerFeasibilityTerm(const TermContext& c)
-      : SampleTermOfOneKind(c.scenario.inner.feasibility == InnerFeasibility::Margin ? kInnerMargin : kInnerFeasibility), c_(c) {}
+  explicit InnerFeasibilityTerm(const TermContext& c) : c_(c) {}
+  RowPlace place() const override { return RowPlace::Sample; }
+  std::vector<ConstraintKindInfo> kinds() const override { return {kInnerFeasibility, kInnerMargin}; }
+  const ConstraintKindInfo& kind(int, int) const override {
+    return c_.scenario.inner.feasibility == InnerFeasibility::Margin ? kInnerMargin : kInnerFeasibility;
+  }
   void appendRows(RowSink& sink) const override {
     if (c_.bilevel) sink.outputRow(0, c_.outputs.infeasibility(), c_.allJoints, false);
   }

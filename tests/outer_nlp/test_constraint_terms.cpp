@@ -37,6 +37,9 @@ std::vector<Variant> variants() {
   Scenario lean = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
   lean.samples = 12;
   out.push_back({"lean reach, bilevel", lean});
+  lean.inner.feasibility = InnerFeasibility::Margin;
+  out.push_back({"lean reach, bilevel, margin row", lean});
+  lean.inner.feasibility = InnerFeasibility::Slack;
   lean.contactForces = "variables";
   out.push_back({"lean reach, variables", lean});
   return out;
@@ -94,7 +97,7 @@ TEST_CASE("constraint terms: every row's kind is registered, every registered ki
   }
   CHECK(laidOut == registered);
   CHECK(documentedKinds() == registered);
-  CHECK(registered.size() == 11);
+  CHECK(registered.size() == 12);
 }
 
 TEST_CASE("constraint terms: a sample's rows follow the registry's order, and each row's bounds, name and instant are its term's",
