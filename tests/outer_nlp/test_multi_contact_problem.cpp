@@ -56,6 +56,15 @@ Scenario tooFastWeightShift(InnerFeasibility feasibility) {
   return s;
 }
 
+/// The rows of `kind` and every row's value at x.
+std::vector<int> rowsOfKind(MotionProblem& problem, const Eigen::VectorXd& x, const std::string& kind, Eigen::VectorXd& values) {
+  problem.constraints(x, values);
+  std::vector<int> rows;
+  for (int r = 0; r < problem.constraintCount(); ++r)
+    if (problem.rowKind(r) == kind) rows.push_back(r);
+  return rows;
+}
+
 /// The rows' Jacobian against central differences (h = 1e-6): the worst relative error, the
 /// largest finite-difference entry and the smallest exact row's largest entry.
 struct RowDerivativeCheck {
@@ -169,15 +178,13 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
   MotionProblem problem(s);
   Eigen::VectorXd x = test::perturbedMotion(problem, 0.3, 11);
   Eigen::VectorXd g;
-  problem.constraints(x, g);
+  const std::vector<int> rows = rowsOfKind(problem, x, "inner_feasibility", g);
   const int infeasible = problem.infeasibleSamples();
   INFO("infeasible samples " << infeasible);
   REQUIRE(infeasible > 0);
   // φ rows: positive exactly at the infeasible samples, with an exact gradient there.
-  std::vector<int> rows;
   int positive = 0;
-  for (int r = 0; r < problem.constraintCount(); ++r)
-    if (problem.rowKind(r) == "inner_feasibility") rows.push_back(r), positive += g[r] > 0.0;
+  for (const int r : rows) positive += g[r] > 0.0;
   CHECK(positive == infeasible);
   const RowDerivativeCheck c = rowDerivatives(problem, x, rows);
   INFO("φ rows: largest derivative " << c.largest << ", worst relative error " << c.worst);
@@ -198,16 +205,13 @@ TEST_CASE("multi-contact outer problem: the admissibility margin rows are signed
   MotionProblem problem(s);
   Eigen::VectorXd x = test::perturbedMotion(problem, 0.3, 11);
   Eigen::VectorXd g;
-  problem.constraints(x, g);
+  const std::vector<int> rows = rowsOfKind(problem, x, "inner_margin", g);
+  CHECK(rowsOfKind(problem, x, "inner_feasibility", g).empty());
   const int infeasible = problem.infeasibleSamples();
   INFO("infeasible samples " << infeasible);
   REQUIRE(infeasible > 0);
-  std::vector<int> rows;
   int positive = 0, negative = 0;
-  for (int r = 0; r < problem.constraintCount(); ++r) {
-    CHECK(problem.rowKind(r) != "inner_feasibility");
-    if (problem.rowKind(r) == "inner_margin") rows.push_back(r), positive += g[r] > 0.0, negative += g[r] < 0.0;
-  }
+  for (const int r : rows) positive += g[r] > 0.0, negative += g[r] < 0.0;
   CHECK(positive >= infeasible);  // the margin is conservative by ε/2 ‖F̃‖²: never less
   CHECK(negative > 0);
   CHECK(positive + negative == static_cast<int>(rows.size()));
