@@ -35,6 +35,17 @@ AdmissibilityMargin::AdmissibilityMargin(const ContactProblem& layout, MarginSet
   qp_->gradient.setZero(n);
   qp_->gradient[variables_] = -1.0;
   qp_->inequalityCount = rows_;
+  // Each row over the scaled variables, divided by its normal's norm: t is a distance. The
+  // contact models' rows are in the contacts' own frames, fixed for a contact set: built once.
+  for (int i = 0; i < rows_; ++i) {
+    auto row = qp_->inequality.row(i);
+    row.head(variables_) = layout.inequality.row(i).cwiseProduct(scale_.transpose());
+    const double norm = row.head(variables_).norm();
+    const double inverse = norm > 0.0 ? 1.0 / norm : 1.0;
+    row.head(variables_) *= inverse;
+    row[variables_] = 1.0;
+    qp_->inequalityBound[i] = layout.inequalityBound[i] * inverse;
+  }
 }
 
 AdmissibilityMargin::~AdmissibilityMargin() = default;
@@ -53,16 +64,6 @@ void AdmissibilityMargin::solve(const ContactProblem& p, MarginResult& r) {
     qp_->equality.row(k).head(variables_) = p.balance.row(k).cwiseProduct(scale_.transpose()) / rowScale;
     qp_->equality(k, variables_) = 0.0;
     qp_->equalityTarget[k] = p.balanceTarget[k] / rowScale;
-  }
-  // Each row over the scaled variables, divided by its normal's norm: t is a distance.
-  for (int i = 0; i < rows_; ++i) {
-    auto row = qp_->inequality.row(i);
-    row.head(variables_) = p.inequality.row(i).cwiseProduct(scale_.transpose());
-    const double norm = row.head(variables_).norm();
-    const double inverse = norm > 0.0 ? 1.0 / norm : 1.0;
-    row.head(variables_) *= inverse;
-    row[variables_] = 1.0;
-    qp_->inequalityBound[i] = p.inequalityBound[i] * inverse;
   }
   const auto status = qp_->solve(r.activeSet, settings_.maxIterations, 1e-13);
   r.iterations = qp_->iterations;

@@ -59,7 +59,8 @@ class AdmissibilityMargin {
   AdmissibilityMargin(AdmissibilityMargin&&) noexcept;
   AdmissibilityMargin& operator=(AdmissibilityMargin&&) noexcept;
 
-  /// The margin of `problem` (the same contact set: sizes are checked). Warm-started from the
+  /// The margin of `problem`: the layout's contact set, whose rows were scaled at construction
+  /// (sizes are checked; the balance and W are read here). Warm-started from the
   /// active set in `result`.
   void solve(const ContactProblem& problem, MarginResult& result);
 
