@@ -115,6 +115,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
                scenario.inner.problem),
       weight_(scenario.robot.totalMass() * scenario.gravity.norm()) {
   hessian_ = options.hessian;
+  derivativesLaidOut_ = options.derivatives;
   // The scenario file checks this with its line; a command-line override (--contact-forces)
   // or a hand-built scenario meets it here.
   if (hessian_ == HessianOption::Exact)
@@ -212,16 +213,18 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   blocks_.resize(static_cast<std::size_t>(samples_.sampleCount()));
   for (int s = 0; s < samples_.sampleCount(); ++s) {
     SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
-    b.y.setZero(outputs), b.dyDT.setZero(outputs), b.wrenches.setZero(6 * (1 + contacts));
-    b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
+    b.y.setZero(outputs), b.wrenches.setZero(6 * (1 + contacts));
     formulation_->layOutForceColumns(s, b.forceTerms, b.forceColumns);
-    b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
-    b.closureMap.setZero(3 * closing, 3 * jointCount_);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     // The contacts in contact here are closed (a window's end sampled once or on its side within).
     for (int i = 0; closure_ && i < contacts; ++i)
       if (contactActive(i, s)) b.closed |= ClosureSet{1} << i;
     b.startFromSplines = sampleSides_[static_cast<std::size_t>(s)] != 0;
+    if (!derivativesLaidOut_) continue;  // values only: no derivative blocks
+    b.dyDT.setZero(outputs);
+    b.dyDq.setZero(outputs, jointCount_), b.dyDv.setZero(outputs, jointCount_), b.dyDa.setZero(outputs, jointCount_);
+    b.dyDz.setZero(outputs, static_cast<Eigen::Index>(b.forceColumns.size()));
+    b.closureMap.setZero(3 * closing, 3 * jointCount_);
     // Local parameters of every sample (the chain rule's column order), fixed for good.
     samples_.chainRule(s, 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
@@ -229,12 +232,14 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   for (std::size_t i = 0; i < taskBlocks_.size(); ++i) {
     SampleBlock& b = taskBlocks_[i];
     const int d = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[i])].dimension();
-    b.y.setZero(d), b.dyDT.setZero(d);
-    b.dyDq.setZero(d, jointCount_), b.dyDv.setZero(d, jointCount_), b.dyDa.setZero(d, jointCount_);
-    b.closureMap.setZero(3 * closing, 3 * jointCount_);
+    b.y.setZero(d);
     b.closedAngles.setConstant(closing, std::numeric_limits<double>::quiet_NaN());
     // At a window's end the task reads the splines' state: there they meet the closure.
     if (closure_) b.closed = closure_->closedAround(taskSamples_.time(static_cast<int>(i), 1.0));
+    if (!derivativesLaidOut_) continue;
+    b.dyDT.setZero(d);
+    b.dyDq.setZero(d, jointCount_), b.dyDv.setZero(d, jointCount_), b.dyDa.setZero(d, jointCount_);
+    b.closureMap.setZero(3 * closing, 3 * jointCount_);
     taskSamples_.chainRule(static_cast<int>(i), 1.0, b.dyDq, b.dyDv, b.dyDa, b.dyDx, b.parameters);
   }
   // Sparsity within a sample: with forces fixed by the formulation's variables, Γ_i (and
@@ -347,6 +352,8 @@ MotionProblem::InnerStatistics MotionProblem::innerStatistics() const {
 
 void MotionProblem::evaluate(const Eigen::VectorXd& x, bool derivatives) {
   if (x.size() != variableCount_) throw InputError("motion problem: wrong number of variables");
+  if (derivatives && !derivativesLaidOut_)
+    throw std::logic_error("motion problem: derivatives asked of a problem built without them (MotionProblemOptions::derivatives)");
   if (cacheValid_ && (cachedDerivatives_ || !derivatives) && x == cachedX_) return;
   if (!x.allFinite()) throw InputError("motion problem: non-finite variables");
   const double T = duration(x);

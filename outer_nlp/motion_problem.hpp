@@ -134,6 +134,11 @@ struct MotionProblemOptions {
   /// docs/reference/scenario-file.md), where rows far from their bound are checked after the
   /// solve instead of weighing on every KKT factorisation.
   std::vector<bool> omittedTorqueRows;
+  /// Whether the problem lays out its Jacobian (and can evaluate derivatives). Without it, only
+  /// values: the objective, the rows, sampledPhysics, violations; a derivative asked for throws
+  /// std::logic_error. For the fine grids of the energy balance and of `mcopt verify`
+  /// (thousands of samples), whose Jacobian would take gigabytes and most of their time.
+  bool derivatives = true;
 };
 
 class MotionProblem final : public NlpProblem {
@@ -479,6 +484,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<ContactAdmissibilityRows> contactRows_;  ///< per environment contact, on its own wrench
   std::vector<int> torqueJoints_;         ///< joints with a finite torque limit (when limited)
   HessianOption hessian_;
+  bool derivativesLaidOut_ = true;  ///< MotionProblemOptions::derivatives
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants

@@ -76,6 +76,7 @@ void MotionProblem::buildStructure() {
 
    private:
     void entry(int column, JacobianEntry e) {
+      if (!p_.derivativesLaidOut_) return;  // values only: the rows without their Jacobian
       rows_.push_back(static_cast<int>(p_.rows_.size()) - 1), columns_.push_back(column), p_.entries_.push_back(e);
     }
     MotionProblem& p_;

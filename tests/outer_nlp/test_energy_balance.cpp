@@ -8,6 +8,7 @@
 #include <catch2/catch.hpp>
 
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "common/perturbed_motion.hpp"
@@ -81,6 +82,39 @@ TEST_CASE("energy balance: the joints' and contacts' work is the change of mecha
     ++covered;
   }
   CHECK(covered == 7);
+}
+
+TEST_CASE("fine grids: a problem built without derivatives gives the same values and refuses derivatives",
+          "[outer][energy]") {
+  // The energy balance and `mcopt verify` evaluate the motion on thousands of instants: their
+  // problem lays out its rows but no Jacobian (MotionProblemOptions::derivatives). Its values are
+  // the full problem's, to the bit; a derivative asked of it is a programming error, not zeros.
+  for (const char* name : {"hrp2_lean_reach.yaml", "hrp2_throw.yaml", "hrp2_kick.yaml"}) {
+    INFO(name);
+    const Scenario scenario = smaller(name, 11);
+    // The point from a third problem: a closure's Newton starts where its problem's last
+    // evaluation ended, so the two compared start from the same history (none).
+    MotionProblem setup(scenario);
+    const Eigen::VectorXd x = perturbedMotion(setup, scenario, 11, 0.05);
+    MotionProblem full(scenario);
+    MotionProblem values(scenario, {.hessian = scenario.solve.hessian, .omittedTorqueRows = {}, .derivatives = false});
+    REQUIRE(values.constraintCount() == full.constraintCount());
+    REQUIRE(values.variableCount() == full.variableCount());
+    CHECK(full.jacobianNonZeros() > 0);
+    CHECK(values.jacobianNonZeros() == 0);
+    Eigen::VectorXd gFull, gValues;
+    full.constraints(x, gFull);
+    values.constraints(x, gValues);
+    CHECK(gValues == gFull);
+    CHECK(values.objective(x) == full.objective(x));
+    const SampledPhysics a = full.sampledPhysics(x), b = values.sampledPhysics(x);
+    CHECK(b.tau == a.tau);
+    CHECK(b.power == a.power);
+    CHECK(b.energy == a.energy);
+    CHECK(b.closureDrift == a.closureDrift);
+    Eigen::VectorXd jacobian;
+    CHECK_THROWS_AS(values.jacobianValues(x, jacobian), std::logic_error);
+  }
 }
 
 TEST_CASE("energy balance: the identity fails on a wrench or a state the torques were not computed with", "[outer][energy]") {
