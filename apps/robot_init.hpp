@@ -48,6 +48,10 @@ struct RobotDimensions {
   double stanceWidth = 0.0;        ///< between the soles' origins
   double centerOfMassHeight = 0.0; ///< standing
   double armLength = 0.0;          ///< shoulder to hand along the right arm's joints (0: no hand)
+  /// The right hand's speed with each joint between it and the root body (arm and trunk) at its
+  /// URDF velocity limit, every joint's contribution |a_j × (p_hand − p_j)| ω_max,j added (a bound,
+  /// at the zero posture) [m/s]; 0: no hand, or one of those joints without a velocity limit.
+  double handSpeed = 0.0;
   double mass = 0.0;
 };
 

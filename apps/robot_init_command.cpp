@@ -25,7 +25,8 @@ int runRobotInit(const RobotInitSettings& settings) {
             << " cm high above their middle (Ipopt: " << toString(r.standing.status) << ", " << r.standing.iterations
             << " iterations, largest row " << std::scientific << std::setprecision(1) << r.standing.violation << ")\n"
             << std::fixed << std::setprecision(3) << "dimensions: leg " << r.dimensions.legLength << " m, right arm "
-            << r.dimensions.armLength << " m\n";
+            << r.dimensions.armLength << " m, its hand " << std::setprecision(2) << r.dimensions.handSpeed
+            << " m/s with its arm's and trunk's joints at their velocity limits\n";
   if (!r.notes.empty()) {
     std::cout << "\nnotes:\n";
     for (const std::string& n : r.notes) std::cout << "  - " << n << "\n";

@@ -91,6 +91,7 @@ TEST_CASE("robot init: HRP-2 from its URDF alone gives its soles, a standing pos
   CHECK(toss["duration"].as<double>() == Approx(2.0));
   CHECK(toss["tasks"][0]["time"].as<double>() == Approx(1.2));
   CHECK(toss["tasks"][0]["ball_mass"].as<double>() == Approx(0.2));
+  CHECK(toss["tasks"][0]["target"][0].as<double>() == Approx(4.0));  // the starter's distance (the bundled 6 m less 2)
 
   // Every value of actuators.yaml an estimate or the URDF's, and said so.
   std::ifstream actuators(out / "actuators.yaml");
@@ -183,6 +184,13 @@ TEST_CASE("robot init: Talos, JVRC-1 and iCub (robots we did not write) set up, 
     const Json standing = bothFeet(out, "standing");
     CHECK(standing.at("holdable") == true);
     CHECK(standing.at("support_margin_m").get<double>() > 0.05);
+    if (std::string(name) == "talos") {
+      // Talos's arm is longer than HRP-2's (4.6 m by its length) and its joints slower (2.7–4.6
+      // rad/s against 5): the throw's distance follows the hand's speed squared.
+      const YAML::Node toss = YAML::LoadFile((out / "scenarios/throw.yaml").string());
+      CHECK(toss["tasks"][0]["target"][0].as<double>() < 4.5);
+      CHECK_THAT(r.output, Contains("m/s with its arm's and trunk's joints at their velocity limits"));
+    }
 #ifndef MCOPT_UNDER_SANITIZERS
     // Full runs take minutes each (docs/tutorials/own-robot.md has them); here each starter
     // loads, passes its checks and takes its first Ipopt iterations.
