@@ -232,18 +232,19 @@ double armLength(const RobotModel& robot, const ZeroPosture& zero, int frame) {
 }
 
 /// The hand's speed with every joint between it and the root body (the arm's and the trunk's) at
-/// its velocity limit, each joint's contribution |a_j × (p_hand − p_j)| ω_max,j added as if their
-/// directions aligned [m/s]; 0 when one of them has no velocity limit.
+/// its velocity limit, each joint's contribution (its column of the hand's Jacobian, ω_max,j
+/// times |a_j × (p_hand − p_j)| for a revolute joint) added as if their directions aligned
+/// [m/s]; 0 when one of them has no velocity limit.
 double handSpeed(const RobotModel& robot, const ZeroPosture& zero, int frame) {
-  const Vector3 hand = zero.frame(frame).translation;
-  int body = robot.frames[static_cast<std::size_t>(frame)].body;
+  FrameJacobian jacobian;
+  frameJacobian(zero.model, zero.data, zero.model.framePosition(frame), zero.frame(frame).translation, jacobian);
   double speed = 0.0;
-  while (robot.bodies[static_cast<std::size_t>(body)].parentJoint >= 0) {
-    const Joint& joint = robot.joints[static_cast<std::size_t>(robot.bodies[static_cast<std::size_t>(body)].parentJoint)];
-    if (!std::isfinite(joint.limits.velocity)) return 0.0;
-    const RigidTransform pose = zero.body(body);  // the joint's frame is its child body's
-    speed += joint.limits.velocity * (pose.rotation * joint.axis).cross(hand - pose.translation).norm();
-    body = joint.parentBody;
+  for (int j = 0; j < robot.jointCount(); ++j) {
+    const double lever = jacobian.col(j).head<3>().norm();
+    if (lever == 0.0) continue;  // not between the root and the hand
+    const double limit = robot.joints[static_cast<std::size_t>(j)].limits.velocity;
+    if (!std::isfinite(limit)) return 0.0;
+    speed += limit * lever;
   }
   return speed;
 }

@@ -72,7 +72,7 @@ int energyGridInstants(const Scenario& scenario, int atLeast) {
 EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, int instantsPerInterval) {
   if (instantsPerInterval == 0) instantsPerInterval = energyGridInstants(problem.scenario(), 10);
   const Scenario fineScenario = fineGridScenario(problem.scenario(), instantsPerInterval);
-  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .omittedTorqueRows = {}, .derivatives = false});  // values only
+  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
   const SampledPhysics physics = fine.sampledPhysics(fine.pointWithWrenchesFrom(problem, x));
   EnergyBalance b = energyBalanceOf(fine, physics);
   b.instantsPerInterval = instantsPerInterval;

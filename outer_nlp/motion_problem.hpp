@@ -133,7 +133,7 @@ struct MotionProblemOptions {
   /// left out of the NLP — torque-limit screening (formulation.md §10;
   /// docs/reference/scenario-file.md), where rows far from their bound are checked after the
   /// solve instead of weighing on every KKT factorisation.
-  std::vector<bool> omittedTorqueRows;
+  std::vector<bool> omittedTorqueRows{};
   /// Whether the problem lays out its Jacobian (and can evaluate derivatives). Without it, only
   /// values: the objective, the rows, sampledPhysics, violations; a derivative asked for throws
   /// std::logic_error. For the fine grids of the energy balance and of `mcopt verify`

@@ -87,7 +87,7 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   std::vector<double> sampleTimes(sampled.time.data(), sampled.time.data() + sampled.time.size());
 
   const Scenario fineScenario = fineGridScenario(scenario, settings.instantsPerInterval);
-  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .omittedTorqueRows = {}, .derivatives = false});  // values only
+  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
   const Eigen::VectorXd xf = fine.pointWithWrenchesFrom(problem, x);
   const SampledPhysics physics = fine.sampledPhysics(xf);
   v.instants = static_cast<int>(physics.time.size());
