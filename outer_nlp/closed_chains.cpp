@@ -19,6 +19,62 @@ constexpr int kNewtonIterations = 50;
 /// [m, rad], or below 1e-9 once a step no longer halves the residual.
 constexpr double kPoseTolerance = 1e-14, kPoseFloor = 1e-9;
 
+Vector3 worldPoint(const DynamicsData& data, int position, const Vector3& local) {
+  return data.position[static_cast<std::size_t>(position)] + data.rotation[static_cast<std::size_t>(position)] * local;
+}
+
+/// LoopReach of six closing joints (nearest the contact first) by coordinate ascent from
+/// `posture`. Along one revolute joint's angle the squared distance is c + A cos δ + B sin δ
+/// (the inner origin turns about the joint's axis, the outer one stays): its maximum is at
+/// δ = atan2(B, A). Each sweep raises the distance; sweeps stop when no joint moves.
+LoopReach measureReach(const DynamicsModel& model, const std::vector<int>& chain, const Eigen::VectorXd& posture,
+                       DynamicsData& data) {
+  const auto& edges = model.treeJoints();
+  LoopReach r;
+  r.inner = model.positionOfJoint(chain.front());
+  r.outer = model.positionOfJoint(chain.back());
+  // The joint frame is the body's frame times `after`⁻¹: its origin in the body's frame.
+  r.innerPoint = edges[static_cast<std::size_t>(r.inner)].after.inverse().translation;
+  r.outerPoint = edges[static_cast<std::size_t>(r.outer)].after.inverse().translation;
+  Eigen::VectorXd q = posture;
+  auto distance = [&] {
+    forwardKinematics(model, data, q);
+    return (worldPoint(data, r.inner, r.innerPoint) - worldPoint(data, r.outer, r.outerPoint)).norm();
+  };
+  for (int sweep = 0; sweep < 1000; ++sweep) {
+    double moved = 0.0;
+    for (std::size_t k = 1; k + 1 < chain.size(); ++k) {
+      const int j = chain[k], b = model.positionOfJoint(j);
+      if (edges[static_cast<std::size_t>(b)].prismatic) {
+        const JointLimits& limits = model.robot().joints[static_cast<std::size_t>(j)].limits;
+        if (!std::isfinite(limits.lower) || !std::isfinite(limits.upper)) {  // no longest reach (the motion problem says so)
+          r.longest = std::numeric_limits<double>::infinity();
+          return r;
+        }
+        const double before = q[j];
+        q[j] = limits.lower;
+        const double atLower = distance();
+        q[j] = limits.upper;
+        if (distance() < atLower) q[j] = limits.lower;
+        moved = std::max(moved, std::abs(q[j] - before));
+        continue;
+      }
+      forwardKinematics(model, data, q);
+      const Vector3 axis = data.jointAxis[static_cast<std::size_t>(b)].normalized();
+      const Vector3 onAxis = axis.cross(data.jointMoment[static_cast<std::size_t>(b)]);  // a × (o × a): a point of the axis
+      const Vector3 arm = worldPoint(data, r.inner, r.innerPoint) - onAxis;
+      const Vector3 across = arm - axis * axis.dot(arm);
+      const Vector3 toAxis = onAxis - worldPoint(data, r.outer, r.outerPoint);
+      const double turn = std::atan2(toAxis.dot(axis.cross(across)), toAxis.dot(across));
+      q[j] += turn;
+      moved = std::max(moved, std::abs(turn));
+    }
+    if (moved < 1e-13) break;
+  }
+  r.longest = distance();
+  return r;
+}
+
 }  // namespace
 
 ClosedChainData::ClosedChainData(const DynamicsModel& model, int contacts)
@@ -75,6 +131,33 @@ ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> 
                        ") cannot move its frame in every direction at the start posture (singular)");
     }
   }
+  for (int i = 0; i < contactCount(); ++i) {
+    const std::vector<int> chain(closing_.begin() + 6 * i, closing_.begin() + 6 * i + 6);
+    reaches_.push_back(measureReach(model, chain, posture, d.data));
+  }
+}
+
+double ClosedChains::reachRatio(const DynamicsData& data, int contact) const {
+  const LoopReach& r = reach(contact);
+  return (worldPoint(data, r.inner, r.innerPoint) - worldPoint(data, r.outer, r.outerPoint)).norm() / r.longest;
+}
+
+double ClosedChains::reachRatio(const DynamicsModel& model, const DynamicsData& data, int contact,
+                                Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> gradient) const {
+  // d(|e|)/dq_j = eᵀ ∂p_inner/∂q_j / |e| for the joints from the inner body up to the outer
+  // one; those at and above it move both origins rigidly (their column is ⟂ e).
+  const LoopReach& r = reach(contact);
+  const Vector3 inner = worldPoint(data, r.inner, r.innerPoint);
+  const Vector3 e = inner - worldPoint(data, r.outer, r.outerPoint);
+  const double d = e.norm();
+  const Vector3 u = e / (d * r.longest);
+  const auto& edges = model.treeJoints();
+  for (int i = r.inner; i != r.outer && i > 0; i = edges[static_cast<std::size_t>(i)].parent) {
+    const TreeJoint& edge = edges[static_cast<std::size_t>(i)];
+    const Vector3& moment = data.jointMoment[static_cast<std::size_t>(i)];
+    gradient[edge.joint] = edge.prismatic ? u.dot(moment) : u.dot(moment + data.jointAxis[static_cast<std::size_t>(i)].cross(inner));
+  }
+  return d / r.longest;
 }
 
 ClosureSet ClosedChains::closedAt(double u, int side) const {

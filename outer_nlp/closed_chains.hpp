@@ -47,6 +47,23 @@ struct HeldContact {
   std::array<double, 2> window{0.0, 1.0};
 };
 
+/// How far a contact's loop is stretched (docs/theory/outer-problem.md, "Closure by
+/// construction"): the distance between the origins of its outermost and innermost closing
+/// joints (a hip and an ankle, a shoulder and a wrist). Its longest, the loop fully stretched,
+/// is where the closure folds: there the closing joints' Jacobian is singular — the closing
+/// angles' derivatives grow without bound as the loop nears it — and beyond it the contact's
+/// pose is out of reach.
+struct LoopReach {
+  int outer = -1, inner = -1;  ///< tree positions of the outermost and innermost closing joints' bodies
+  Vector3 outerPoint = Vector3::Zero(), innerPoint = Vector3::Zero();  ///< their joint origins, in those bodies' frames
+  /// [m]: the largest distance over the four closing joints between them (the outermost and
+  /// innermost joints turn about the two points and do not change it), found by coordinate
+  /// ascent from the start posture, each revolute joint to its exact maximum (free of its
+  /// limits: the closure is); a prismatic joint to the better end of its range (infinite when
+  /// it has none).
+  double longest = 0.0;
+};
+
 /// Which contacts are closed at an instant: bit i for contact i.
 using ClosureSet = std::uint32_t;
 
@@ -111,6 +128,16 @@ class ClosedChains {
   bool close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> v,
              Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map, ClosureSet set) const;
 
+  /// Contact i's loop: its two joint origins and its longest reach (LoopReach).
+  const LoopReach& reach(int contact) const { return reaches_[static_cast<std::size_t>(contact)]; }
+  /// Contact i's loop's reach as a fraction of its longest at the pose in `data` (forward
+  /// kinematics done), closed or not.
+  double reachRatio(const DynamicsData& data, int contact) const;
+  /// The same, and its derivative in q (1 × n: the joints between the two origins; the others'
+  /// entries are not written — the caller zeroes the row).
+  double reachRatio(const DynamicsModel& model, const DynamicsData& data, int contact,
+                    Eigen::Ref<Eigen::RowVectorXd, 0, Eigen::InnerStride<>> gradient) const;
+
   /// The largest distance [m] and angle [rad] of a frame of `set` from its world pose at q.
   std::pair<double, double> poseError(const DynamicsModel& model, ClosedChainData& d, const Eigen::VectorXd& q,
                                       ClosureSet set) const;
@@ -126,6 +153,7 @@ class ClosedChains {
   Eigen::VectorXd posture_;  ///< the start posture: Newton's second start
   std::vector<int> closing_, contactOf_;
   std::vector<bool> closes_;
+  std::vector<LoopReach> reaches_;
 };
 
 }  // namespace mcopt

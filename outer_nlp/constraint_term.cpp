@@ -12,6 +12,7 @@ ConstraintTerms makeConstraintTerms(const TermContext& context) {
   terms.push_back(makeContactAdmissibilityTerm(context));
   terms.push_back(makeInnerFeasibilityTerm(context));
   terms.push_back(makeClosingJointLimitTerm(context));
+  terms.push_back(makeLoopReachTerm(context));
   terms.push_back(makeEnergyEpigraphTerm(context));
   terms.push_back(makeTaskTerm(context));
   return terms;

@@ -2,7 +2,7 @@
 #pragma once
 // The outer problem's constraint rows as terms (formulation.md §10; docs/theory/outer-problem.md,
 // "Constraint terms"). A term is one row family — velocity limits, torque limits, contact
-// admissibility, inner feasibility, closing-joint limits, the energy epigraph, tasks — as a
+// admissibility, inner feasibility, closing-joint limits, loop reach, the energy epigraph, tasks — as a
 // const model: it lays out its rows and their sparsity, gives their bounds, kinds and names,
 // and says how each row reads the motion. The motion problem (motion_problem.hpp) owns the
 // terms, keeps one registry of their rows and evaluates them; nothing else names a family.
@@ -139,6 +139,7 @@ ConstraintTerms makeConstraintTerms(const TermContext& context);
 std::unique_ptr<const ConstraintTerm> makeVelocityLimitTerm(const TermContext& context);     // limit_terms.cpp
 std::unique_ptr<const ConstraintTerm> makeTorqueLimitTerm(const TermContext& context);       // limit_terms.cpp
 std::unique_ptr<const ConstraintTerm> makeClosingJointLimitTerm(const TermContext& context); // limit_terms.cpp
+std::unique_ptr<const ConstraintTerm> makeLoopReachTerm(const TermContext& context);         // loop_reach_term.cpp
 std::unique_ptr<const ConstraintTerm> makeContactAdmissibilityTerm(const TermContext& context);  // contact_terms.cpp
 std::unique_ptr<const ConstraintTerm> makeInnerFeasibilityTerm(const TermContext& context);      // contact_terms.cpp
 std::unique_ptr<const ConstraintTerm> makeEnergyEpigraphTerm(const TermContext& context);   // energy_epigraph_term.cpp

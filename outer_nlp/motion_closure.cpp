@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <tuple>
 
 #include "core/contact_maps.hpp"
 #include "core/errors.hpp"
@@ -38,6 +39,31 @@ void MotionProblem::startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoi
   }
   startTaskClosures();
   closureStarted_ = true;
+}
+
+void MotionProblem::checkLoopReaches() const {
+  const double margin = scenario_.closureReachMargin;
+  DynamicsData data(model_);
+  const auto& joints = scenario_.robot.joints;
+  for (int i = 0; i < closure_->contactCount(); ++i) {
+    const LoopReach& reach = closure_->reach(i);
+    const std::string loop = "the loop of contact '" + closure_->contacts()[static_cast<std::size_t>(i)].name + "' (" +
+                             joints[static_cast<std::size_t>(closure_->closingJoints()[static_cast<std::size_t>(6 * i + 5)])].name + " to " +
+                             joints[static_cast<std::size_t>(closure_->closingJoints()[static_cast<std::size_t>(6 * i)])].name + ")";
+    if (!std::isfinite(reach.longest))
+      throw InputError(scenario_.file.string() + ": closure_reach_margin: " + loop +
+                       " has a sliding joint without limits, so no longest reach");
+    for (const auto& [fixed, posture, u, side, name] :
+         {std::tuple{scenario_.fixStart, &scenario_.start, 0.0, +1, "start"}, std::tuple{scenario_.fixEnd, &scenario_.end, 1.0, -1, "end"}}) {
+      if (!fixed || !((closure_->closedAt(u, side) >> i) & 1U)) continue;
+      forwardKinematics(model_, data, *posture);
+      const double ratio = closure_->reachRatio(data, i);
+      if (ratio > 1.0 - margin)
+        throw InputError(scenario_.file.string() + ": closure_reach_margin: the fixed " + name + " posture stretches " + loop +
+                         " to " + std::to_string(ratio) + " of its longest reach (" + std::to_string(reach.longest) +
+                         " m), beyond 1 − " + std::to_string(margin) + "; lower the margin or bend the posture");
+    }
+  }
 }
 
 void MotionProblem::startTaskClosures() {

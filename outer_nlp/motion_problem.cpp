@@ -154,6 +154,10 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   if (!held.empty()) closure_ = std::make_unique<ClosedChains>(model_, std::move(held), scenario_.start);
   const int closing = closure_ ? closure_->closingCount() : 0;
   outputs_.closing = closing;
+  if (closure_ && scenario_.closureReachMargin > 0.0) {
+    outputs_.reaches = closure_->contactCount();
+    checkLoopReaches();
+  }
   // Trapezoid weights as fractions of T, (u_{s+1} − u_{s−1}) / 2: 1 / (N − 1) between regular
   // samples, halved at the ends and, where an instant is sampled twice (a throw's release, a
   // window's end: the power jumps there), each twin its side's half interval.

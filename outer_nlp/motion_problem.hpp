@@ -363,6 +363,9 @@ class MotionProblem final : public NlpProblem {
   void startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoints, double duration);
   /// Each task instant's Newton start: the nearest sample's angles.
   void startTaskClosures();
+  /// closure_reach_margin: every loop has a longest reach, and a fixed start or end posture
+  /// where its contact is closed keeps its loop within 1 − margin of it (InputError otherwise).
+  void checkLoopReaches() const;
   /// The same at an evaluation's own state: the map into b (with derivatives) and the angles
   /// reached kept in b for the next Newton start.
   void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives);

@@ -80,6 +80,18 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
     b.dyDq(outputs_.closingPosition(k), j) = 1.0;
     b.dyDv(outputs_.closingVelocity(k), j) = 1.0;
   }
+  // Each held contact's loop's reach, a fraction of its longest (closed_chains.hpp LoopReach):
+  // a function of the pose alone.
+  for (int i = 0; i < outputs_.reaches; ++i) {
+    const int row = outputs_.loopReach(i);
+    if (!derivatives) {
+      b.y[row] = closure_->reachRatio(w.data, i);
+      continue;
+    }
+    b.dyDq.row(row).setZero(), b.dyDv.row(row).setZero(), b.dyDa.row(row).setZero();
+    if (b.dyDz.cols() > 0) b.dyDz.row(row).setZero();
+    b.y[row] = closure_->reachRatio(model, w.data, i, b.dyDq.row(row));
+  }
 }
 
 void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, ThreadWorkspace& w) {

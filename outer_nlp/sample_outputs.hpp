@@ -24,7 +24,9 @@ struct SampleOutputs {
   int closing = 0;  ///< joints that close an environment contact (closed_chains.hpp)
   int closingPosition(int k) const { return power(joints) + k; }
   int closingVelocity(int k) const { return power(joints) + closing + k; }
-  int size() const { return power(joints) + 2 * closing; }
+  int reaches = 0;  ///< held contacts whose loop's reach is bounded (closure_reach_margin > 0), else 0
+  int loopReach(int i) const { return power(joints) + 2 * closing + i; }
+  int size() const { return power(joints) + 2 * closing + reaches; }
 };
 
 }  // namespace mcopt

@@ -166,7 +166,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance", "refine",
+                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance",
+                           "closure_reach_margin", "refine",
                            "allow_nonphysical_inertia"});
   Scenario s;
   s.file = file;
@@ -319,7 +320,17 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     if (node["orientation"])
       s.closureOrientationTolerance = yaml::nonNegative(file, node["orientation"], "closure_tolerance.orientation");
   }
+  if (root["closure_reach_margin"]) {
+    const YAML::Node node = root["closure_reach_margin"];
+    s.closureReachMargin = yaml::nonNegative(file, node, "closure_reach_margin");
+    if (!(s.closureReachMargin < 1.0))
+      throw InputError(where(file, node, "closure_reach_margin") + "expected a fraction of the longest reach in [0, 1), got " +
+                       std::to_string(s.closureReachMargin));
+  }
   readContacts(file, contactsNode, surfaces, s);
+  if (s.closureReachMargin > 0.0 && s.contacts.empty())
+    throw InputError(where(file, root["closure_reach_margin"], "closure_reach_margin") +
+                     "the scenario holds no contact besides the reference body's: there is no loop to keep from full stretch");
   if (root["contact_forces"]) {
     const YAML::Node node = root["contact_forces"];
     try {

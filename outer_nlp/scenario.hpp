@@ -91,6 +91,10 @@ struct Scenario {
   /// (docs/theory/outer-problem.md, "Multi-contact").
   double closurePositionTolerance = 1e-3;     ///< [m]
   double closureOrientationTolerance = 1e-3;  ///< [rad], on sin θ of the error rotation
+  /// `closure_reach_margin` m: each held contact's loop stays at most (1 − m) of its longest
+  /// reach at the samples where it is closed, away from full stretch where the closure folds
+  /// (closed_chains.hpp LoopReach; docs/theory/outer-problem.md). 0: no such rows.
+  double closureReachMargin = 0.0;
   /// How the contact wrenches enter the outer problem (formulation.md §9): a registered
   /// formulation's name (formulation_registry.hpp).
   std::string contactForces = "bilevel";

@@ -27,8 +27,8 @@ struct Variant {
 
 /// Between them, rows of every kind: the kick with the epigraph (velocity and torque limits,
 /// its sole's report-model rows, its toe task, the epigraph), the lean reach bilevel (inner
-/// feasibility, the hand's closure rows and closing joints) and with `variables` (the
-/// wrench-cone's yaw rows).
+/// feasibility, the hand's closure rows and closing joints; with the margin row and the loops'
+/// reach) and with `variables` (the wrench-cone's yaw rows).
 std::vector<Variant> variants() {
   std::vector<Variant> out;
   Scenario kick = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
@@ -38,8 +38,10 @@ std::vector<Variant> variants() {
   lean.samples = 12;
   out.push_back({"lean reach, bilevel", lean});
   lean.inner.feasibility = InnerFeasibility::Margin;
-  out.push_back({"lean reach, bilevel, margin row", lean});
+  lean.closureReachMargin = 1e-3;
+  out.push_back({"lean reach, bilevel, margin row, loop reach", lean});
   lean.inner.feasibility = InnerFeasibility::Slack;
+  lean.closureReachMargin = 0.0;
   lean.contactForces = "variables";
   out.push_back({"lean reach, variables", lean});
   return out;
@@ -97,7 +99,7 @@ TEST_CASE("constraint terms: every row's kind is registered, every registered ki
   }
   CHECK(laidOut == registered);
   CHECK(documentedKinds() == registered);
-  CHECK(registered.size() == 12);
+  CHECK(registered.size() == 13);
 }
 
 TEST_CASE("constraint terms: a sample's rows follow the registry's order, and each row's bounds, name and instant are its term's",
