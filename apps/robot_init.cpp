@@ -453,6 +453,12 @@ std::string weightShiftYaml(const RobotInitResult& r, const std::string& urdfNam
                       urdfName, left, r.allowNonPhysicalInertia)
     << "contacts: [" << left.surface.name << ", " << right.surface.name << "]\n"
     << "contact_forces: bilevel\n"
+    // The right leg's loop (closed through the pelvis to the left sole) kept short of full
+    // stretch, where the closure folds (docs/theory/outer-problem.md, "Closure by construction"):
+    // JVRC-1's weight shift, whose knee is straight at 0.163 rad inside its range, stretched its
+    // right leg to 8 mrad of the fold, and no Newton step there ends optimal
+    // (docs/developers/lab-notes/robot-init.md).
+    << "closure_reach_margin: 1.0e-3   # the right leg kept short of full stretch (about 5 degrees of knee bend)\n"
     // The barrier inner solver's smooth answers (docs/theory/inner-problem.md): with the active-set
     // solver Talos's weight shift cycled at a kink of the criterion; with μ = 0.01 W it ends
     // optimal, as HRP-2's and iCub's do (docs/developers/lab-notes/robot-init.md).
@@ -509,6 +515,12 @@ std::string throwYaml(const RobotInitResult& r, const std::string& urdfName, con
     << scenarioHeader(r.robot.name + " on both soles throws a ball with its right hand at a target on the floor", urdfName, left, r.allowNonPhysicalInertia)
     << "contacts: [" << left.surface.name << ", " << right.surface.name << "]\n"
     << "contact_forces: bilevel\n"
+    // The right leg's loop (closed through the pelvis to the left sole) kept short of full
+    // stretch, where the closure folds (docs/theory/outer-problem.md, "Closure by construction"):
+    // JVRC-1's weight shift, whose knee is straight at 0.163 rad inside its range, stretched its
+    // right leg to 8 mrad of the fold, and no Newton step there ends optimal
+    // (docs/developers/lab-notes/robot-init.md).
+    << "closure_reach_margin: 1.0e-3   # the right leg kept short of full stretch (about 5 degrees of knee bend)\n"
     // The margin row (docs/theory/outer-problem.md, "Inner feasibility"): it has a gradient at the
     // edge of what the soles can hold, where the slack row's vanishes. JVRC-1's throw, whose
     // samples ran into infeasible inner problems with the slack row, ends optimal with it, and

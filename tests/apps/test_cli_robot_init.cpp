@@ -92,6 +92,9 @@ TEST_CASE("robot init: HRP-2 from its URDF alone gives its soles, a standing pos
   CHECK(toss["tasks"][0]["time"].as<double>() == Approx(1.2));
   CHECK(toss["tasks"][0]["ball_mass"].as<double>() == Approx(0.2));
   CHECK(toss["tasks"][0]["target"][0].as<double>() == Approx(4.0));  // the starter's distance (the bundled 6 m less 2)
+  // Both two-sole starters keep the right leg's loop short of full stretch.
+  CHECK(shift["closure_reach_margin"].as<double>() == Approx(1e-3));
+  CHECK(toss["closure_reach_margin"].as<double>() == Approx(1e-3));
 
   // Every value of actuators.yaml an estimate or the URDF's, and said so.
   std::ifstream actuators(out / "actuators.yaml");
