@@ -252,6 +252,9 @@ int runMotion(const RunOptions& o) {
     std::cout << " (all stages:";
     for (std::size_t k = 0; k < record.stages.size(); ++k) std::cout << (k == 0 ? " " : " + ") << record.stages[k].iterations;
     std::cout << ")";
+  } else if (record.stages.size() == 1 && record.stages.front().rounds > 1) {
+    // Rows that joined after an optimum were solved again: the last solve's count alone hides the others.
+    std::cout << " (" << record.stages.front().iterations << " over " << record.stages.front().rounds << " torque-screening solves)";
   }
   std::cout << "\n"
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds

@@ -660,6 +660,10 @@ TEST_CASE("run: torque-limit screening solves again with the rows that came near
   CHECK(rounds >= 2);
   CHECK(left > 0);
   CHECK(left < 8 * 30);
+  // The summary counts every solve's iterations, not the last one's alone.
+  const int total = result["solver"]["iterations_all_stages"].get<int>();
+  CHECK(total > result["solver"]["iterations"].get<int>());
+  CHECK_THAT(r.output, Contains("(" + std::to_string(total) + " over " + std::to_string(rounds) + " torque-screening solves)"));
   // At least `left` joint-samples are below the fraction of their limit, and none is beyond its limit.
   const RobotModel robot = loadUrdfFile(test::sourceDir() / "robots/hrp2/hrp2.urdf");
   const ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
