@@ -3,6 +3,9 @@
 // An NlpProblem's sparse Jacobian as a dense matrix, its declared pattern, and its exact
 // derivatives' errors against central differences, for the derivative tests of the outer problems.
 #include <Eigen/Core>
+#include <algorithm>
+#include <limits>
+#include <vector>
 
 #include "common/finite_differences.hpp"
 #include "outer_nlp/nlp_problem.hpp"
@@ -56,6 +59,31 @@ inline DerivativeErrors derivativeErrors(NlpProblem& problem, Eigen::VectorXd x,
   e.jacobian = ((jacobian - jacobianFd).array().abs() / (1.0 + jacobianFd.array().abs())).maxCoeff();
   e.offPattern = (jacobianFd.array() * (1.0 - pattern.array())).abs().maxCoeff();
   return e;
+}
+
+/// Some rows' Jacobian against central differences (step h): the worst relative error
+/// |exact − differences| / (1 + |differences|), the largest difference entry and the smallest
+/// exact row's largest entry.
+struct RowDerivativeCheck {
+  double worst = 0.0, largest = 0.0, smallestRow = std::numeric_limits<double>::infinity();
+};
+inline RowDerivativeCheck rowDerivatives(NlpProblem& problem, Eigen::VectorXd& x, const std::vector<int>& rows, double h = 1e-6) {
+  const Eigen::MatrixXd jacobian = denseJacobian(problem, x);
+  const Eigen::MatrixXd fd = centralDifferences(x, h, [&] {
+    Eigen::VectorXd values;
+    problem.constraints(x, values);
+    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
+    for (std::size_t k = 0; k < rows.size(); ++k) out[static_cast<Eigen::Index>(k)] = values[rows[k]];
+    return out;
+  });
+  RowDerivativeCheck c;
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const Eigen::RowVectorXd exact = jacobian.row(rows[k]), differences = fd.row(static_cast<Eigen::Index>(k));
+    c.worst = std::max(c.worst, ((exact - differences).array().abs() / (1.0 + differences.array().abs())).maxCoeff());
+    c.largest = std::max(c.largest, differences.cwiseAbs().maxCoeff());
+    c.smallestRow = std::min(c.smallestRow, exact.cwiseAbs().maxCoeff());
+  }
+  return c;
 }
 
 }  // namespace mcopt::test

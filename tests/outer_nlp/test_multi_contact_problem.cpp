@@ -65,29 +65,6 @@ std::vector<int> rowsOfKind(MotionProblem& problem, const Eigen::VectorXd& x, co
   return rows;
 }
 
-/// The rows' Jacobian against central differences (h = 1e-6): the worst relative error, the
-/// largest finite-difference entry and the smallest exact row's largest entry.
-struct RowDerivativeCheck {
-  double worst = 0.0, largest = 0.0, smallestRow = std::numeric_limits<double>::infinity();
-};
-RowDerivativeCheck rowDerivatives(MotionProblem& problem, Eigen::VectorXd& x, const std::vector<int>& rows) {
-  const Eigen::MatrixXd jacobian = test::denseJacobian(problem, x);
-  const Eigen::MatrixXd fd = test::centralDifferences(x, 1e-6, [&] {
-    Eigen::VectorXd values;
-    problem.constraints(x, values);
-    Eigen::VectorXd out(static_cast<Eigen::Index>(rows.size()));
-    for (std::size_t k = 0; k < rows.size(); ++k) out[static_cast<Eigen::Index>(k)] = values[rows[k]];
-    return out;
-  });
-  RowDerivativeCheck c;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    const Eigen::RowVectorXd exact = jacobian.row(rows[k]), differences = fd.row(static_cast<Eigen::Index>(k));
-    c.worst = std::max(c.worst, ((exact - differences).array().abs() / (1.0 + differences.array().abs())).maxCoeff());
-    c.largest = std::max(c.largest, differences.cwiseAbs().maxCoeff());
-    c.smallestRow = std::min(c.smallestRow, exact.cwiseAbs().maxCoeff());
-  }
-  return c;
-}
 
 }  // namespace
 
@@ -186,7 +163,7 @@ TEST_CASE("multi-contact outer problem: infeasible bilevel samples are counted a
   int positive = 0;
   for (const int r : rows) positive += g[r] > 0.0;
   CHECK(positive == infeasible);
-  const RowDerivativeCheck c = rowDerivatives(problem, x, rows);
+  const test::RowDerivativeCheck c = test::rowDerivatives(problem, x, rows);
   INFO("φ rows: largest derivative " << c.largest << ", worst relative error " << c.worst);
   CHECK(c.largest > 1e-6);  // the rows do steer
   // Measured: ≤ 5e-7 at 8 of the 9 infeasible samples, 2.7e-6 at the one whose least-slack
@@ -215,7 +192,7 @@ TEST_CASE("multi-contact outer problem: the admissibility margin rows are signed
   CHECK(positive >= infeasible);  // the margin is conservative by ε/2 ‖F̃‖²: never less
   CHECK(negative > 0);
   CHECK(positive + negative == static_cast<int>(rows.size()));
-  const RowDerivativeCheck c = rowDerivatives(problem, x, rows);
+  const test::RowDerivativeCheck c = test::rowDerivatives(problem, x, rows);
   INFO("margin rows: smallest gradient " << c.smallestRow << ", worst relative error " << c.worst);
   CHECK(c.smallestRow > 1e-6);  // every row steers
   CHECK(c.worst < 1e-6);
