@@ -137,6 +137,11 @@ ClosedChains::ClosedChains(const DynamicsModel& model, std::vector<HeldContact> 
   }
 }
 
+std::string ClosedChains::loopName(const RobotModel& robot, int contact) const {
+  const auto joint = [&](int k) { return robot.joints[static_cast<std::size_t>(closing_[static_cast<std::size_t>(6 * contact + k)])].name; };
+  return "the loop of " + contacts_[static_cast<std::size_t>(contact)].name + " (" + joint(5) + " to " + joint(0) + ")";
+}
+
 double ClosedChains::reachRatio(const DynamicsData& data, int contact) const {
   const LoopReach& r = reach(contact);
   return (worldPoint(data, r.inner, r.innerPoint) - worldPoint(data, r.outer, r.outerPoint)).norm() / r.longest;

@@ -130,6 +130,9 @@ class ClosedChains {
 
   /// Contact i's loop: its two joint origins and its longest reach (LoopReach).
   const LoopReach& reach(int contact) const { return reaches_[static_cast<std::size_t>(contact)]; }
+  /// "the loop of r_sole (RLEG_JOINT0 to RLEG_JOINT5)": the contact and the outermost and
+  /// innermost closing joints, for messages and row names.
+  std::string loopName(const RobotModel& robot, int contact) const;
   /// Contact i's loop's reach as a fraction of its longest at the pose in `data` (forward
   /// kinematics done), closed or not.
   double reachRatio(const DynamicsData& data, int contact) const;

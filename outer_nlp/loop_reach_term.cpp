@@ -30,11 +30,7 @@ class LoopReachTerm final : public SampleTermOfOneKind {
     upper = 1.0 - c_.scenario.closureReachMargin;
   }
   void subject(int contact, int, std::ostream& name) const override {
-    const auto& joints = c_.scenario.robot.joints;
-    const auto& closing = c_.closure->closingJoints();
-    name << "reach of the loop of " << c_.closure->contacts()[static_cast<std::size_t>(contact)].name << " ("
-         << joints[static_cast<std::size_t>(closing[static_cast<std::size_t>(6 * contact + 5)])].name << " to "
-         << joints[static_cast<std::size_t>(closing[static_cast<std::size_t>(6 * contact)])].name << ")";
+    name << "reach of " << c_.closure->loopName(c_.scenario.robot, contact);
   }
 
  private:

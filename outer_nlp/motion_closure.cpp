@@ -44,12 +44,9 @@ void MotionProblem::startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoi
 void MotionProblem::checkLoopReaches() const {
   const double margin = scenario_.closureReachMargin;
   DynamicsData data(model_);
-  const auto& joints = scenario_.robot.joints;
   for (int i = 0; i < closure_->contactCount(); ++i) {
     const LoopReach& reach = closure_->reach(i);
-    const std::string loop = "the loop of contact '" + closure_->contacts()[static_cast<std::size_t>(i)].name + "' (" +
-                             joints[static_cast<std::size_t>(closure_->closingJoints()[static_cast<std::size_t>(6 * i + 5)])].name + " to " +
-                             joints[static_cast<std::size_t>(closure_->closingJoints()[static_cast<std::size_t>(6 * i)])].name + ")";
+    const std::string loop = closure_->loopName(scenario_.robot, i);
     if (!std::isfinite(reach.longest))
       throw InputError(scenario_.file.string() + ": closure_reach_margin: " + loop +
                        " has a sliding joint without limits, so no longest reach");
