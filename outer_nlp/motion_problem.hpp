@@ -147,6 +147,10 @@ class MotionProblem final : public NlpProblem {
   /// The problem with the scenario's own Hessian model (scenario.solve.hessian) and every
   /// torque-limit row.
   explicit MotionProblem(const Scenario& scenario);
+  /// The problem keeps a reference to its scenario (rows, names and terms read it): a
+  /// temporary would leave it dangling, so one does not compile.
+  MotionProblem(Scenario&&, MotionProblemOptions) = delete;
+  explicit MotionProblem(Scenario&&) = delete;
   /// The Hessian model it was built with.
   HessianOption hessianOption() const { return hessian_; }
   /// Per joint and sample (index s · n + j): whether |Γ_js| < fraction · its limit at x

@@ -67,7 +67,8 @@ TEST_CASE("energy balance: the joints' and contacts' work is the change of mecha
               << b.electricalResidual() << " J");
     // The fine grid: perInterval instants an interval, a throw's release and each window's end twice.
     CHECK(b.instants >= perInterval * (samples - 1) + 1 + (scenario.ball ? 1 : 0));
-    CHECK(b.instants == MotionProblem(fineGridScenario(scenario, perInterval)).sampleCount());
+    const Scenario fine = fineGridScenario(scenario, perInterval);
+    CHECK(b.instants == MotionProblem(fine).sampleCount());
     CHECK(b.mechanicalScale() > 0.1);  // a motion that does something
     // Simpson's rule on a grid whose pairs do not straddle a knot: far below the 1e-4 asked
     // (at 11 samples, under the sanitizers, the hand-supported throw's is 1.6e-6).
