@@ -23,8 +23,10 @@
 #include "core/atomic_file.hpp"
 #include "core/dynamics_data.hpp"
 #include "core/errors.hpp"
+#include "core/inverse_dynamics.hpp"
 #include "core/kinematics.hpp"
 #include "core/robot_files.hpp"
+#include "outer_nlp/closed_chains.hpp"
 #include "outer_nlp/posture_check.hpp"
 #include "outer_nlp/scenario.hpp"
 
@@ -49,6 +51,9 @@ struct SupportCheck {
   bool checked = true;
   std::string note;        ///< why it was not checked, or what to know
   PostureCheck check;
+  /// On both feet: the second leg's loop's reach as a fraction of its longest (fully
+  /// stretched; closed_chains.hpp LoopReach), what `closure_reach_margin` bounds.
+  std::optional<double> loopReach;
 };
 
 /// The robot folder's files: DIR holds one .urdf and actuators.yaml, contacts.yaml, postures.yaml
@@ -139,6 +144,11 @@ SupportCheck checkSupport(const RobotCheckOptions& o, const fs::path& scratch, c
     const Scenario scenario = loadScenario(file, std::nullopt, o.allowNonPhysicalInertia);
     MotionProblem problem(scenario);
     result.check = checkFixedPostures(problem).front();
+    if (const ClosedChains* chains = problem.closedChains()) {
+      DynamicsData data(problem.model());
+      forwardKinematics(problem.model(), data, scenario.start);
+      result.loopReach = chains->reachRatio(data, 0);
+    }
   } catch (const InputError& e) {
     // The robot's files were read before; what fails here is the posture on this support (a
     // closure singular at it: a straight knee). Said without the scratch file's name.
@@ -239,6 +249,7 @@ Json checkJson(const SupportCheck& c) {
   j["torques_beyond_limits"] = excess;
   j["static_electrical_power_W"] = c.check.staticPower;
   if (!c.check.innerStatus.empty()) j["inner_status"] = c.check.innerStatus;
+  if (c.loopReach) j["loop_reach"] = *c.loopReach;
   return j;
 }
 
@@ -314,8 +325,9 @@ int runRobotCheck(RobotCheckOptions o) {
   }
   printJointValues(robot, actuators);
   std::cout << "robot " << robot.name << " (" << o.robot << "), feet " << feet[0] << " and " << feet[1]
-            << "; each posture at rest (margin: the centre of mass inside (+) or outside (−) the support polygon)\n\n"
-            << "  posture               support                  margin    largest static torque / limit       power   \n";
+            << "; each posture at rest (margin: the centre of mass inside (+) or outside (−) the support polygon;\n"
+            << "stretch: on both feet, the second leg's hip-ankle distance over its longest, which closure_reach_margin bounds)\n\n"
+            << "  posture               support                  margin    largest static torque / limit       power     stretch\n";
   for (const SupportCheck& c : results) {
     std::string support;
     for (const std::string& s : c.support) support += (support.empty() ? "" : " + ") + s;
@@ -330,6 +342,7 @@ int runRobotCheck(RobotCheckOptions o) {
     std::cout << std::fixed << std::setprecision(1) << std::showpos << std::setw(6) << 100.0 * c.check.supportMargin
               << " cm" << std::noshowpos << "   " << std::left << std::setw(32) << torque.str() << std::right
               << std::setw(8) << c.check.staticPower << " W";
+    if (c.loopReach) std::cout << std::setprecision(4) << std::setw(10) << *c.loopReach;
     if (!c.check.holdable()) std::cout << "   cannot hold it";
     if (c.check.innerStatus == "infeasible") std::cout << " (no admissible wrenches)";
     for (const auto& t : c.check.torques) std::cout << "; " << t.joint << " beyond its limit";

@@ -11,6 +11,9 @@
 #include "common/run_command.hpp"
 #include "common/temp_dir.hpp"
 #include "common/test_support.hpp"
+#include "core/inverse_dynamics.hpp"
+#include "core/robot_files.hpp"
+#include "core/robot_model.hpp"
 
 using namespace mcopt;
 using Catch::Matchers::Contains;
@@ -56,6 +59,24 @@ TEST_CASE("robot check: half-sitting on both feet and on one, as inverse dynamic
   CHECK(both.at("inner_status") == "optimal");
   // Half-sitting is symmetric: its centre of mass halfway between the soles (0.12 m apart).
   CHECK(both.at("center_of_mass_m")[1].get<double>() == Approx(-0.06).margin(2e-3));
+  // The right leg's stretch: its hip-ankle distance (RLEG_JOINT0 to RLEG_JOINT5) at
+  // half-sitting over the same at the zero posture, where HRP-2's leg is straight (its longest).
+  {
+    const RobotModel robot = loadUrdfFile(kHrp2 / "hrp2.urdf");
+    const DynamicsModel model(robot, "BODY");
+    DynamicsData data(model);
+    const auto hipToAnkle = [&](const Eigen::VectorXd& q) {
+      forwardKinematics(model, data, q);
+      return (data.position[static_cast<std::size_t>(model.positionOfJoint(robot.findJoint("RLEG_JOINT5")))] -
+              data.position[static_cast<std::size_t>(model.positionOfJoint(robot.findJoint("RLEG_JOINT0")))])
+          .norm();
+    };
+    const auto postures = loadPostures(kHrp2 / "postures.yaml", robot);
+    const double expected = hipToAnkle(postures.at("half_sitting")) / hipToAnkle(Eigen::VectorXd::Zero(robot.jointCount()));
+    CHECK(expected < 0.99);
+    CHECK(both.at("loop_reach").get<double>() == Approx(expected).epsilon(1e-9));
+  }
+  CHECK(!find(report, "half_sitting", {"l_sole"}).contains("loop_reach"));  // one foot: no loop
 
   // On one sole: HRP-2's soles are 0.13 m wide and 0.12 m apart, so the centre of mass halfway
   // between them is 5 mm inside either (robots/hrp2/contacts.yaml).
