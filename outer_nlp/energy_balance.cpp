@@ -73,7 +73,7 @@ EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, in
   if (instantsPerInterval == 0) instantsPerInterval = energyGridInstants(problem.scenario(), 10);
   const Scenario fineScenario = fineGridScenario(problem.scenario(), instantsPerInterval);
   MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
-  const SampledPhysics physics = fine.sampledPhysics(fine.pointWithWrenchesFrom(problem, x));
+  const SampledPhysics physics = fine.sampledPhysics(fine.pointWithWrenchesFrom(problem, x), MotionProblem::ClosureDrift::Skipped);
   EnergyBalance b = energyBalanceOf(fine, physics);
   b.instantsPerInterval = instantsPerInterval;
   return b;

@@ -59,7 +59,7 @@ std::optional<ReleaseState> MotionProblem::release(const Eigen::VectorXd& x) con
   return r;
 }
 
-SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
+SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x, ClosureDrift drift) {
   evaluate(x, false);
   const int N = samples_.sampleCount(), n = jointCount_, contacts = outputs_.contacts;
   const double T = duration(x);
@@ -115,9 +115,9 @@ SampledPhysics MotionProblem::sampledPhysics(const Eigen::VectorXd& x) {
   // samples or 10 instants per sample interval, whichever is finer, and each window's ends, read
   // from the splines there (where they meet the closure): how far each frame strays from its
   // world pose and how fast it slides. Nothing to do without environment contacts.
-  for (std::vector<double>* drift : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
-    drift->assign(static_cast<std::size_t>(contacts), 0.0);
-  if (contacts == 0) return p;
+  for (std::vector<double>* figure : {&p.closureDrift, &p.closureRotationDrift, &p.closureSpeed, &p.closureAngularSpeed})
+    figure->assign(static_cast<std::size_t>(contacts), 0.0);
+  if (contacts == 0 || drift == ClosureDrift::Skipped) return p;
   const int fineCount = std::max(scenario_.outputSamples, 10 * (scenario_.samples - 1) + 1);
   std::vector<std::pair<double, bool>> instants;  // u, at a window's end
   for (int s = 0; s < fineCount; ++s) instants.emplace_back(static_cast<double>(s) / (fineCount - 1), false);

@@ -89,7 +89,7 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   const Scenario fineScenario = fineGridScenario(scenario, settings.instantsPerInterval);
   MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
   const Eigen::VectorXd xf = fine.pointWithWrenchesFrom(problem, x);
-  const SampledPhysics physics = fine.sampledPhysics(xf);
+  const SampledPhysics physics = fine.sampledPhysics(xf, MotionProblem::ClosureDrift::Skipped);
   v.instants = static_cast<int>(physics.time.size());
 
   // Every row of the problem on the fine grid, by kind (the epigraph's slacks are set at

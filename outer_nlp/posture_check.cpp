@@ -81,7 +81,7 @@ std::vector<PostureCheck> checkFixedPostures(MotionProblem& problem) {
   if (!scenario.fixStart && !scenario.fixEnd) return checks;
   // The motion that stays at rest in each fixed posture at its end of the motion.
   const Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end);
-  const SampledPhysics physics = problem.sampledPhysics(x);
+  const SampledPhysics physics = problem.sampledPhysics(x, MotionProblem::ClosureDrift::Skipped);
   const DynamicsModel& model = problem.model();
   DynamicsData data(model);
   const int last = problem.sampleCount() - 1;

@@ -16,13 +16,8 @@ BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurf
       solver_(makeInnerSolver(settings.solverName, settings.solver)),
       sensitivity_(sensitivity) {
   if (contacts_.empty()) throw InputError("bilevel sample: no contact surface given");
-  const int n = model.jointCount(), variables = sample_.problem.variableCount();
-  torque_.setZero(n), g_.setZero(n), linearDv_.setZero(n), linearDa_.setZero(n);
-  for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_, &fixedDq_, &fixedDv_, &fixedDa_})
-    m->setZero(n, n);
-  dF_.setZero(variables, 3 * n), stationarity_.setZero(variables, 3 * n), balance_.setZero(6, 3 * n);
-  for (auto* m : {&dBFdq_, &dLeastSlackBFdq_, &dWorld_, &dTorqueT_, &dWorldT_}) m->setZero(6, n);
-  for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
+  const int variables = sample_.problem.variableCount();
+  torque_.setZero(model.jointCount());
   // Room for the largest active set, so that warm starts copy without allocating.
   result_.activeSet.reserve(static_cast<std::size_t>(sample_.problem.inequality.rows()) + sample_.problem.cones.size());
   if (settings.feasibility == InnerFeasibility::Margin) {
@@ -37,6 +32,16 @@ BilevelSample::BilevelSample(const DynamicsModel& model, std::vector<ContactSurf
     marginResult_.activeSet.reserve(static_cast<std::size_t>(sample_.problem.inequality.rows()) + 1);
     marginResult_.wrenches.setZero(variables);
   }
+}
+
+void BilevelSample::sizeDerivatives(int n) {
+  const int variables = sample_.problem.variableCount();
+  g_.setZero(n), linearDv_.setZero(n), linearDa_.setZero(n);
+  for (Eigen::MatrixXd* m : {&dTorqueDq_, &dTorqueDv_, &dTorqueDa_, &dJ1Fdq_, &dTorque_, &scaled_, &fixedDq_, &fixedDv_, &fixedDa_})
+    m->setZero(n, n);
+  dF_.setZero(variables, 3 * n), stationarity_.setZero(variables, 3 * n), balance_.setZero(6, 3 * n);
+  for (auto* m : {&dBFdq_, &dLeastSlackBFdq_, &dWorld_, &dTorqueT_, &dWorldT_}) m->setZero(6, n);
+  for (Eigen::RowVectorXd* r : {&dInfeasibilityDq_, &dInfeasibilityDv_, &dInfeasibilityDa_}) r->setZero(n);
 }
 
 BilevelSample::~BilevelSample() = default;
@@ -76,6 +81,7 @@ void BilevelSample::evaluate(const DynamicsModel& model, const DynamicsData& dat
   infeasibility_ = byMargin ? -marginResult_.margin : infeasible ? scale_ * leastSlack_.squaredNorm() : 0.0;
   hasWrenchDerivative_ = false;
   if (!withDerivatives) return;
+  if (dTorqueDq_.rows() != n) sizeDerivatives(n);  // the first evaluation with derivatives
 
   // ∂(J1 F)/∂q and ∂(B F)/∂q at the chosen wrenches.
   dJ1Fdq_.setZero();

@@ -69,7 +69,8 @@ class BilevelSample {
   /// right-hand side of dF*/d(q, q̇, q̈) (InnerSensitivity::kktMatrix, rightHandSide).
   const Eigen::MatrixXd& kktMatrix() const { return sensitivity_.kktMatrix(); }
   void kktRightHandSide(Eigen::MatrixXd& rhs) const { sensitivity_.rightHandSide(stationarity_, balance_, rhs); }
-  /// dF*/d(q, q̇, q̈) solved elsewhere (wrench variables × 3n); the torque derivatives follow (4.8).
+  /// dF*/d(q, q̇, q̈) solved elsewhere (wrench variables × 3n), after an evaluation with
+  /// derivatives; the torque derivatives follow (4.8).
   void setWrenchDerivative(const Eigen::Ref<const Eigen::MatrixXd>& dF);
 
   /// Starts the next solve from `other`'s result (a neighbouring sample with the same contacts).
@@ -79,7 +80,8 @@ class BilevelSample {
   const InnerResult& innerResult() const { return result_; }
   const SampleProblem& problem() const { return sample_; }
   /// Γ = Γ0 − J1 F* (n), the feasibility row (φ, or −m_ε with the margin; ≤ 0 when feasible),
-  /// and with derivatives n × n blocks and 1 × n rows.
+  /// and with derivatives n × n blocks and 1 × n rows (empty before the first evaluation with
+  /// derivatives).
   const Eigen::VectorXd& torque() const { return torque_; }
   double infeasibility() const { return infeasibility_; }
   const Eigen::MatrixXd& torqueDq() const { return dTorqueDq_; }
@@ -108,6 +110,10 @@ class BilevelSample {
   double infeasibility_ = 0.0;
   Eigen::VectorXd torque_, g_, linearDv_, linearDa_;
   void updateTorqueDerivatives();
+  /// The derivatives' buffers, sized at the first evaluation that asks for them: a values-only
+  /// problem (the energy balance's and `mcopt verify`'s fine grids, thousands of samples) never
+  /// allocates them (about 90 kB a sample on HRP-2).
+  void sizeDerivatives(int n);
 
   Eigen::MatrixXd dTorqueDq_, dTorqueDv_, dTorqueDa_, dF_, stationarity_, balance_, dJ1Fdq_, dTorque_, scaled_;
   Eigen::MatrixXd fixedDq_, fixedDv_, fixedDa_;  ///< ∂Γ/∂x at fixed wrenches

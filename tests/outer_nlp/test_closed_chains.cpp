@@ -249,6 +249,13 @@ TEST_CASE("closed chains: a window's contact holds inside it, and the splines me
   CHECK(motion > 1e-4);
   // Outside it the arm is its splines': the ends' mismatch is what the drift reports.
   CHECK(p.closureDrift[1] > 1e-6);
+  // Without the drift's grid (the fine grids' call): the same samples, to the bit, and no drift.
+  const SampledPhysics skipped = problem.sampledPhysics(x, MotionProblem::ClosureDrift::Skipped);
+  CHECK(skipped.q == p.q);
+  CHECK(skipped.tau == p.tau);
+  CHECK(skipped.wrenches == p.wrenches);
+  CHECK(skipped.closureDrift == std::vector<double>(2, 0.0));
+  CHECK(skipped.closureSpeed == std::vector<double>(2, 0.0));
 }
 
 TEST_CASE("closed chains: a loop that cannot be closed is refused, naming the contact", "[outer][closure]") {
