@@ -266,6 +266,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"smoothing", stage.energyForm == EnergyForm::Epigraph ? Json(nullptr) : Json(stage.smoothing)},
                       {"samples", stage.samples},
                       {"hessian", toString(stage.hessian)},
+                      {"inner_solver", stage.innerSolver.empty() ? Json(nullptr) : Json(stage.innerSolver)},
                       {"status", toString(stage.status)},
                       {"iterations", stage.iterations},
                       {"seconds", stage.seconds},

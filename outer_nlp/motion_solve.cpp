@@ -62,6 +62,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     stage.samples = stageScenario.samples;
     stage.hessian = stageScenario.solve.hessian;
     stage.energyForm = stageScenario.energyForm;
+    if (full.bilevel()) stage.innerSolver = stageScenario.inner.solverName;
     OuterOutcome outcome;
     int joined = 0;
     for (;;) {

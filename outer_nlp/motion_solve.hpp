@@ -22,6 +22,7 @@ struct StageOutcome {
   int samples = 0;
   HessianOption hessian = HessianOption::SampleDifferences;
   EnergyForm energyForm = EnergyForm::SmoothMaximum;
+  std::string innerSolver;  ///< bilevel: the stage's inner solver; empty otherwise
   OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
   double objective = 0.0;                           ///< of its last solve
   int iterations = 0;                               ///< over its rounds

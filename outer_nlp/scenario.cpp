@@ -372,8 +372,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
       yaml::rejectUnknownKeys(file, stage, field,
                               {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy",
-                               "for_contact_forces"});
-      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}};
+                               "for_contact_forces", "inner_solver"});
+      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}, {}};
       if (stage["energy"]) {
         const std::string form = yaml::text(file, stage["energy"], field + ".energy");
         if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
@@ -410,6 +410,16 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
             throw InputError(where(file, only[i], item) + "'" + forces + "' is listed twice");
           c.forContactForces.push_back(forces);
         }
+      }
+      if (const YAML::Node inner = stage["inner_solver"]) {
+        const std::string innerField = field + ".inner_solver";
+        if (s.contacts.empty())
+          throw InputError(where(file, inner, innerField) +
+                           "the scenario has no contact besides the reference body's: no inner problem picks wrenches");
+        c.innerSolver = yaml::text(file, inner, innerField);
+        if (!isInnerSolverName(c.innerSolver))
+          throw InputError(where(file, inner, innerField) + "unknown inner solver '" + c.innerSolver + "' (expected " +
+                           innerSolverList() + ")");
       }
       if (stage["max_iterations"]) c.maxIterations = yaml::integerAtLeast(file, stage["max_iterations"], field + ".max_iterations", 1);
       if (stage["friction_sharpness"])
@@ -451,6 +461,19 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
     const YAML::Node inner = root["inner"];
     throw InputError(where(file, inner["contact_model"] ? inner["contact_model"] : inner["solver"], "inner.solver") + why);
   }
+  bool barrierUsed = s.inner.solverName == "barrier";
+  for (std::size_t k = 0; k < s.solve.continuation.size(); ++k) {
+    if (s.solve.continuation[k].innerSolver != "barrier") continue;
+    barrierUsed = true;
+    if (const std::string why = barrierModelRefusal(continuationStage(s, k)); !why.empty()) {
+      const std::string field = "continuation[" + std::to_string(k) + "].inner_solver";
+      throw InputError(where(file, root["continuation"][k]["inner_solver"], field) + why);
+    }
+  }
+  if (const YAML::Node inner = root["inner"]; inner && inner["barrier"] && !barrierUsed)
+    throw InputError(where(file, inner["barrier"], "inner.barrier") +
+                     "only the barrier inner solver has a barrier parameter, and neither inner.solver nor a continuation "
+                     "stage's inner_solver is barrier (inner.solver is " + s.inner.solverName + ")");
   if (const std::string why = marginModelRefusal(s); !why.empty())
     throw InputError(where(file, root["inner"]["feasibility"], "inner.feasibility") + why);
   return s;

@@ -90,6 +90,7 @@ void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
     if (!isInnerSolverName(*o.innerSolver))
       throw InputError("inner.solver: unknown inner solver '" + *o.innerSolver + "' (expected " + innerSolverList() + ")");
     scenario.inner.solverName = *o.innerSolver;
+    for (ContinuationStage& stage : scenario.solve.continuation) stage.innerSolver.clear();  // every stage's, as --hessian
     if (const std::string why = barrierModelRefusal(scenario); !why.empty()) throw InputError("--inner-solver: " + why);
   }
   if (o.hessian) overrideHessian(scenario, *o.hessian);

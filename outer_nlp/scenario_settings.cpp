@@ -72,12 +72,8 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
                      "), not to every contact — the reference contact carries moments");
   if (node["tolerance"]) s.inner.solver.tolerance = yaml::positive(file, node["tolerance"], "inner.tolerance");
   if (node["polish"]) s.inner.solver.polish = yaml::flag(file, node["polish"], "inner.polish");
-  if (node["barrier"]) {
-    if (s.inner.solverName != "barrier")
-      throw InputError(where(file, node["barrier"], "inner.barrier") + "only the barrier inner solver has a barrier parameter (the solver is " +
-                       s.inner.solverName + ")");
-    s.inner.solver.barrier = yaml::positive(file, node["barrier"], "inner.barrier");
-  }
+  // Whether a solver reads it is checked once the continuation's stages are read (readScenario).
+  if (node["barrier"]) s.inner.solver.barrier = yaml::positive(file, node["barrier"], "inner.barrier");
   if (node["feasibility"]) {
     const std::string name = yaml::text(file, node["feasibility"], "inner.feasibility");
     if (name == "margin") s.inner.feasibility = InnerFeasibility::Margin;
@@ -160,13 +156,16 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
     stage.samples = scenario.solve.continuation[k].samples;
     stage.solve.hessian = scenario.solve.continuation[k].hessian;
     stage.energyForm = scenario.solve.continuation[k].energyForm;
+    if (!scenario.solve.continuation[k].innerSolver.empty()) stage.inner.solverName = scenario.solve.continuation[k].innerSolver;
   }
   return stage;
 }
 
 bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
   return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
-         stage.samples == scenario.samples && stage.energyForm == scenario.energyForm;
+         stage.samples == scenario.samples && stage.energyForm == scenario.energyForm &&
+         (stage.contacts.empty() || !contactForceFormulation(stage.contactForces).innerProblem ||
+          stage.inner.solverName == scenario.inner.solverName);
 }
 
 namespace {

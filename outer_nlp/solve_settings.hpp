@@ -79,6 +79,12 @@ struct ContinuationStage {
   /// `variables` one from converging; docs/theory/outer-problem.md, "Multi-contact"), and
   /// `mcopt run --contact-forces` chooses the formulation after the file is read.
   std::vector<std::string> forContactForces;
+  /// The bilevel inner solver of the stage (`inner_solver`, a registered name); empty: the
+  /// scenario's. The exact optima of the active-set method in a Gauss–Newton stage, then the
+  /// barrier solver's smooth central path for the scenario's own problem, whose stationarity
+  /// test the exact optima's kinks can keep from passing (docs/theory/outer-problem.md,
+  /// "Continuation").
+  std::string innerSolver;
   /// Whether the stage runs with that formulation.
   bool runsWith(const std::string& forces) const {
     return forContactForces.empty() ||

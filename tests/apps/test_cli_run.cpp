@@ -776,7 +776,8 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"inner polishing not a flag", [](YAML::Node& r) { r["inner"]["polish"] = "sometimes"; },
        {"inner.polish: expected true or false"}},
       {"a barrier parameter for another inner solver", [](YAML::Node& r) { r["inner"]["barrier"] = 1e-3; },
-       {"inner.barrier: only the barrier inner solver has a barrier parameter (the solver is active-set)"}},
+       {"inner.barrier: only the barrier inner solver has a barrier parameter, and neither inner.solver nor a "
+        "continuation stage's inner_solver is barrier (inner.solver is active-set)"}},
       {"a barrier parameter not positive", [](YAML::Node& r) {
          r["inner"]["solver"] = "barrier";
          r["inner"]["contact_model"] = "wrench-cone";
@@ -844,6 +845,19 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"continuation stage formulations without a second contact", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel]}]");
        }, {"continuation[0].for_contact_forces: the scenario has no contact besides the reference body's"}},
+      {"continuation stage's unknown inner solver", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: qpoases}]");
+       }, {"continuation[0].inner_solver: unknown inner solver 'qpoases' (expected active-set"}},
+      {"continuation stage's inner solver without a second contact", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: active-set}]");
+       }, {"continuation[0].inner_solver: the scenario has no contact besides the reference body's"}},
+      {"continuation stage's barrier solver on second-order cones", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
+         r["inner"]["contact_model"] = "report";
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: barrier}]");
+       }, {"continuation[0].inner_solver: the barrier inner solver smooths linear contact models only",
+           "the report model (inner.contact_model) has second-order friction cones"}},
       {"continuation iteration limit not positive", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{max_iterations: 0}]");
        }, {"continuation[0].max_iterations: expected an integer ≥ 1"}},
@@ -963,6 +977,51 @@ TEST_CASE("run: a continuation stage for some formulations runs only with them",
     for (std::size_t k = 0; k < hessians.size(); ++k) CHECK(stages[k]["hessian"] == hessians[k]);
     CHECK_THAT(r.output, Contains(hessians.size() == 1 ? "Hessian: sample-differences;" : "stage 1 of 2"));
   }
+}
+
+TEST_CASE("run: a continuation stage's inner solver solves that stage and the scenario's solves its own problem while --inner-solver sets both",
+          "[cli][run][multi-contact]") {
+  // The bundled weight shift's layout (active-set optima in the Gauss–Newton stage, the barrier's
+  // central path for the scenario's problem) on 12 samples, one iteration a stage.
+  const test::TempDir dir;
+  const auto staged = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+    root["inner"]["solver"] = "barrier";
+    root["inner"]["barrier"] = 1e-3;
+    root["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: active-set}]");
+  }, "weight_shift_staged.yaml");
+  struct Case {
+    std::string arguments;
+    std::vector<Json> solvers;  ///< each stage's inner_solver in result.json
+  };
+  const std::vector<Case> cases = {{"", {"active-set", "barrier"}},
+                                   {"--inner-solver slsqp", {"slsqp", "slsqp"}},
+                                   {"--contact-forces variables", {nullptr, nullptr}}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto out = dir.path() / ("run" + std::to_string(i));
+    const auto r = test::runMcopt("run " + test::quoted(staged) + " " + cases[i].arguments + " --out " + test::quoted(out) +
+                                  " --max-iterations 1");
+    INFO(cases[i].arguments << ": " << r.all());
+    REQUIRE(r.exitCode == 4);
+    const Json stages = readJson(out / "result.json")["continuation"];
+    REQUIRE(stages.size() == cases[i].solvers.size());
+    for (std::size_t k = 0; k < stages.size(); ++k) {
+      CHECK(stages[k]["inner_solver"] == cases[i].solvers[k]);
+      if (!cases[i].solvers[k].is_null())
+        CHECK_THAT(r.output, Contains("stage " + std::to_string(k + 1) + " of 2: ") &&
+                                 Contains(", inner solver " + cases[i].solvers[k].get<std::string>()));
+    }
+  }
+  // The barrier parameter is the stage's when only a stage takes the barrier solver.
+  const auto barrierStage = scenarioVariant(staged, dir, [](YAML::Node& root) {
+    root["inner"]["solver"] = "active-set";
+    root["continuation"][0]["inner_solver"] = "barrier";
+  }, "weight_shift_barrier_stage.yaml");
+  const auto r = test::runMcopt("run " + test::quoted(barrierStage) + " --out " + test::quoted(dir.path() / "barrier_stage") +
+                                " --max-iterations 1");
+  INFO(r.all());
+  CHECK(r.exitCode == 4);
+  CHECK_THAT(r.output, Contains(", inner solver barrier") && Contains(", inner solver active-set"));
 }
 
 TEST_CASE("run: knuckles on the table as a point contact: a force alone, recorded with its model", "[cli][run][multi-contact]") {
@@ -1114,6 +1173,7 @@ TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][ru
   // The barrier solver on the report model's cones: refused before anything runs.
   const auto report = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
     root["samples"] = 8;
+    root["inner"]["solver"] = "active-set";  // the file's own barrier would be refused first
     root["inner"]["contact_model"] = "report";
   }, "weight_shift_report.yaml");
   const auto onCones = test::runMcopt("run " + test::quoted(report) + " --inner-solver barrier --out " +

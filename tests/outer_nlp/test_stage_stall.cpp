@@ -2,10 +2,13 @@
 // The hand-over of a stalled continuation stage (outer_nlp/motion_solve.hpp, StageStallWatch;
 // docs/theory/outer-problem.md, "Continuation"): a window of regular iterations whose criterion
 // moves by at most its relative change, every one of them feasible; restoration iterates,
-// infeasible ones and steady progress restart or withhold it.
+// infeasible ones and steady progress restart or withhold it. And which stages pose the
+// scenario's own problem (continuationStage, posesScenarioProblem).
 #include <catch2/catch.hpp>
 
+#include "common/test_support.hpp"
 #include "outer_nlp/motion_solve.hpp"
+#include "outer_nlp/scenario.hpp"
 
 using namespace mcopt;
 
@@ -67,4 +70,25 @@ TEST_CASE("stage stall: a flat feasible window hands on, progress and infeasible
     CHECK(stalledAt(watch, small) == 10);
   }
   CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{1, 1e-6, 1e-6}));
+}
+
+TEST_CASE("continuation: a stage with another inner solver poses another problem, only where an inner problem picks the wrenches",
+          "[outer][continuation]") {
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
+  s.inner.solverName = "barrier";
+  ContinuationStage stage = s.solve.continuation.at(0);
+  stage.innerSolver = "active-set";
+  s.solve.continuation = {stage};
+  const Scenario first = continuationStage(s, 0), own = continuationStage(s, 1);
+  CHECK(first.inner.solverName == "active-set");
+  CHECK(own.inner.solverName == "barrier");
+  CHECK_FALSE(posesScenarioProblem(first, s));  // its optimum does not end the run
+  CHECK(posesScenarioProblem(own, s));
+  // The same stage with the scenario's own solver (empty: the scenario's) differs in its Hessian only.
+  s.solve.continuation[0].innerSolver.clear();
+  CHECK(posesScenarioProblem(continuationStage(s, 0), s));
+  // Single-level formulations have no inner problem: the inner solver does not tell two problems apart.
+  s.solve.continuation[0].innerSolver = "active-set";
+  s.contactForces = "variables";
+  CHECK(posesScenarioProblem(continuationStage(s, 0), s));
 }
