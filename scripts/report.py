@@ -141,6 +141,12 @@ def optimisations(mcopt, source, work, quick, time_limit):
             label = f"{name}/{forces}" + (f"/{solver}" if solver else "")
             arguments = ["--contact-forces", forces] + (["--inner-solver", solver] if solver else []) + extra
             runs[label] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / label.replace("/", "-"), arguments, time_limit)
+        # The file's own inner solvers (--inner-solver sets every stage's: the weight shift's
+        # Gauss-Newton stage takes the active-set method, its own problem the barrier solver).
+        if name == "weight_shift" or not quick:
+            label = f"{name}/bilevel/as-bundled"
+            runs[label] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / label.replace("/", "-"),
+                              ["--contact-forces", "bilevel", *extra], time_limit)
     # The throws (docs/reference/scenario-file.md, "Throw"), each as bundled; --quick: the double-support one.
     for name in ("throw",) if quick else ("throw", "throw_one_foot", "throw_hand_support", "throw_free_release"):
         runs[name] = run(mcopt, scenarios / f"hrp2_{name}.yaml", work / name, extra, time_limit)

@@ -48,7 +48,7 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
     runs = report["optimisations"]
     expected = {"kick/configuration-on", "kick/configuration-off", "lean_reach/bilevel/active-set"}
     expected |= {"kick-free-ends/configuration-on", "kick-free-ends/configuration-off"}
-    expected |= {f"weight_shift/bilevel/{s}" for s in ("active-set", "slsqp", "ipopt")}
+    expected |= {f"weight_shift/bilevel/{s}" for s in ("active-set", "slsqp", "ipopt", "as-bundled")}
     expected |= {"weight_shift/splines", "weight_shift/variables", "throw"}
     assert set(runs) == expected
     for label, run in runs.items():
@@ -64,6 +64,8 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
         assert run["seconds"] > 0 and run["energy_J"] > 0 and run["max_violation"] >= 0, label
     # The runs are what their arguments say.
     assert "--inner-solver" in runs["weight_shift/bilevel/ipopt"]["arguments"]
+    assert runs["weight_shift/bilevel/as-bundled"]["arguments"][:2] == ["--contact-forces", "bilevel"]
+    assert "--inner-solver" not in runs["weight_shift/bilevel/as-bundled"]["arguments"]
     assert runs["kick/configuration-off"]["arguments"][:2] == ["--configuration-optimisation", "off"]
 
 
