@@ -5,6 +5,7 @@
 // bilevel samples —, the one-contact problem reproduced by each formulation, and the balance.
 #include <catch2/catch.hpp>
 
+#include <map>
 #include <random>
 
 #include "common/finite_differences.hpp"
@@ -343,6 +344,28 @@ TEST_CASE("multi-contact outer problem: the bundled multi-contact scenarios eval
       else
         CHECK(closureRows == 0);
     }
+  }
+}
+
+
+TEST_CASE("single-level formulations start from the exact inner optimum whatever the bilevel inner solver is",
+          "[outer][multi-contact]") {
+  // The bundled weight shift's own problem takes the barrier solver; its splines and variables
+  // runs start from the active-set method's wrenches along the initial motion all the same.
+  for (const char* forces : {"variables", "splines"}) {
+    std::map<std::string, Eigen::VectorXd> starts;
+    for (const char* solver : {"active-set", "barrier", "slsqp"}) {
+      Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
+      s.samples = 12;
+      s.contactForces = forces;
+      s.inner.solverName = solver;
+      MotionProblem problem(s);
+      starts[solver] = problem.initialPoint(s.start, s.end);
+      REQUIRE(problem.forceVariableCount() > 0);
+    }
+    INFO(forces);
+    CHECK(starts.at("barrier") == starts.at("active-set"));
+    CHECK(starts.at("slsqp") == starts.at("active-set"));
   }
 }
 
