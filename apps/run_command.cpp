@@ -304,7 +304,7 @@ Runner addRun(CLI::App& command) {
   command.add_option("--max-iterations", o->maxIterations,
                      "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,
-                     innerSolverList() + ": override the scenario's inner.solver (bilevel, formulation.md §7; " +
+                     innerSolverList() + ": override the scenario's inner.solver and every continuation stage's inner_solver (bilevel, formulation.md §7; " +
                          "`mcopt inner --help` says what each is)")
       ->check(CLI::IsMember(innerSolverNames()));
   command.add_option("--hessian", o->hessian,
