@@ -1,12 +1,39 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // mcopt: whole-body motion optimisation for humanoid robots in multi-contact.
+#include <unistd.h>
+
+#include <cstdlib>
 #include <iostream>
 
 #include "apps/commands.hpp"
 #include "core/errors.hpp"
 #include "core/version.hpp"
 
+namespace {
+
+// One BLAS kernel set on every processor that has it (docs/developers/determinism.md): OpenBLAS
+// picks its kernels by processor when it loads, before main, and MUMPS's factorisations round
+// differently with each set, so Ipopt took other paths on other processors (a throw neighbour
+// optimal with the Haswell kernels ended maximum_iterations with the AVX-512 ones). On a
+// processor with AVX2 and FMA, unless OPENBLAS_CORETYPE is set already, the command starts
+// itself again with OPENBLAS_CORETYPE=Haswell; where that fails it goes on as it is.
+void pinBlasKernels(char** argv) {
+#if defined(__x86_64__) && defined(__linux__)
+  if (std::getenv("OPENBLAS_CORETYPE") != nullptr) return;
+  __builtin_cpu_init();
+  if (!__builtin_cpu_supports("avx2") || !__builtin_cpu_supports("fma")) return;
+  if (setenv("OPENBLAS_CORETYPE", "Haswell", 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  unsetenv("OPENBLAS_CORETYPE");  // not started again: this process keeps the kernels it has
+#else
+  (void)argv;
+#endif
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  pinBlasKernels(argv);
   CLI::App app{"mcopt — whole-body motion optimisation for humanoid robots in multi-contact"};
   app.set_version_flag("--version", std::string("mcopt ") + mcopt::kVersion);
   app.require_subcommand(1);

@@ -17,6 +17,11 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(env -u OMP_NUM_THREADS -u OMP_THREAD_LIMIT nproc)"
 "$root/scripts/install-deps.sh"
+# The same BLAS kernels on every AVX2 processor, for the library tests that run Ipopt in their
+# own process too (the mcopt command sets this itself: docs/developers/determinism.md).
+if [ -z "${OPENBLAS_CORETYPE:-}" ] && grep -qw avx2 /proc/cpuinfo && grep -qw fma /proc/cpuinfo; then
+  export OPENBLAS_CORETYPE=Haswell
+fi
 
 cmake --preset release -S "$root"
 cmake --build "$root/build/release" --parallel "$jobs"

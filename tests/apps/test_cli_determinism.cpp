@@ -185,3 +185,26 @@ TEST_CASE("determinism: every bundled multi-contact scenario in each formulation
   }
   CHECK(scenarios == 5);  // the weight shift, the lean reach and the three throws on both soles
 }
+
+TEST_CASE("determinism: the command loads one BLAS kernel set on every AVX2 processor and keeps a set the caller chose",
+          "[cli][determinism]") {
+  // docs/developers/determinism.md: OpenBLAS picks its kernels by processor when it loads, and
+  // the paths Ipopt takes depend on them. OPENBLAS_VERBOSE=2 makes it name the set it loaded,
+  // on standard error, once per process: the last name is the one the command ran with.
+  const auto lastCore = [](const std::string& errors) {
+    const std::size_t at = errors.rfind("Core: ");
+    return at == std::string::npos ? std::string() : errors.substr(at + 6, errors.find('\n', at) - at - 6);
+  };
+  __builtin_cpu_init();
+  const bool avx2 = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  const test::CommandResult pinned = test::runMcopt("--version", "env -u OPENBLAS_CORETYPE OPENBLAS_VERBOSE=2");
+  INFO(pinned.all());
+  REQUIRE(pinned.exitCode == 0);
+  CHECK(pinned.output.rfind("mcopt ", 0) == 0);
+  if (avx2) CHECK(lastCore(pinned.errors) == "Haswell");
+  const test::CommandResult chosen = test::runMcopt("--version", "OPENBLAS_CORETYPE=Nehalem OPENBLAS_VERBOSE=2");
+  INFO(chosen.all());
+  REQUIRE(chosen.exitCode == 0);
+  CHECK(lastCore(chosen.errors) == "Nehalem");
+  CHECK(chosen.errors.find("Haswell") == std::string::npos);
+}
