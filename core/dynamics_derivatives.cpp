@@ -15,8 +15,12 @@ DynamicsDerivatives::DynamicsDerivatives(const DynamicsModel& model) {
   dwrenchDv.setZero(6, n);
   dwrenchDa.setZero(6, n);
   terms.assign(nb, BodyTerms{});
-  for (auto* v : {&motion, &twist, &acceleration, &momentum, &inertiaTimesAcceleration, &wrench, &alpha, &beta, &gamma})
-    v->assign(nb, Vector6::Zero());
+  for (auto* v : {&motion, &twist, &acceleration, &momentum, &inertiaTimesAcceleration, &wrench}) v->assign(nb, Vector6::Zero());
+  rowFactors.setZero(18, model.bodyCount());
+  columnFactors.setZero(18, model.bodyCount());
+  subtreeWrench.setZero(18, model.bodyCount());
+  jointAt.assign(nb, -1);
+  for (int k = 1; k < model.bodyCount(); ++k) jointAt[static_cast<std::size_t>(k)] = model.treeJoints()[k].joint;
 }
 
 namespace {
@@ -25,26 +29,26 @@ using Terms = DynamicsDerivatives::BodyTerms;
 
 MCOPT_ALWAYS_INLINE Vector6 inertiaTimes(const Terms& t, const Vector6& x) {
   Vector6 out;
-  out.head<3>() = t.mass * x.head<3>() - t.massCom.cross(x.tail<3>());
+  out.head<3>() = t.mass * x.head<3>() - cross3(t.massCom, x.tail<3>());
   out.tail<3>().noalias() = t.rotational * x.tail<3>();
-  out.tail<3>() += t.massCom.cross(x.head<3>());
+  out.tail<3>() += cross3(t.massCom, x.head<3>());
   return out;
 }
 
 // Y x with Y = [[0, [f]×], [−[f]×, E]]; f is the linear momentum of the same bodies.
 MCOPT_ALWAYS_INLINE Vector6 velocityCouplingTimes(const Terms& t, const Vector3& linearMomentum, const Vector6& x) {
   Vector6 out;
-  out.head<3>() = linearMomentum.cross(x.tail<3>());
+  out.head<3>() = cross3(linearMomentum, x.tail<3>());
   out.tail<3>().noalias() = t.velocityBlock * x.tail<3>();
-  out.tail<3>() -= linearMomentum.cross(x.head<3>());
+  out.tail<3>() -= cross3(linearMomentum, x.head<3>());
   return out;
 }
 
 // Z x with Z = [[0, [z₁]×], [[z₁]×, [z₂]×]].
 MCOPT_ALWAYS_INLINE Vector6 momentumCouplingTimes(const Terms& t, const Vector6& x) {
   Vector6 out;
-  out.head<3>() = t.z1.cross(x.tail<3>());
-  out.tail<3>() = t.z1.cross(x.head<3>()) + t.z2.cross(x.tail<3>());
+  out.head<3>() = cross3(t.z1, x.tail<3>());
+  out.tail<3>() = cross3(t.z1, x.head<3>()) + cross3(t.z2, x.tail<3>());
   return out;
 }
 
@@ -79,13 +83,14 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
     d.momentum[i] = inertiaTimes(t, d.twist[i]);
     d.inertiaTimesAcceleration[i] = inertiaTimes(t, d.acceleration[i]);
     d.wrench[i] = d.inertiaTimesAcceleration[i] + forceCross(d.twist[i], d.momentum[i]);
-    const Vector3 lin = d.twist[i].head<3>(), ang = d.twist[i].tail<3>();
+    const Vector3& lin = data.linearVelocity[i];
+    const Vector3& ang = data.angularVelocity[i];
     const Vector3 f = d.momentum[i].head<3>(), n = d.momentum[i].tail<3>();
     const Matrix3 jw = t.rotational * skew(ang);
     t.velocityBlock = lin * t.massCom.transpose() + t.massCom * lin.transpose() -
                       2.0 * t.massCom.dot(lin) * Matrix3::Identity() + jw + jw.transpose();
-    t.z1 = f.cross(ang);
-    t.z2 = f.cross(lin) + n.cross(ang);
+    t.z1 = cross3(f, ang);
+    t.z2 = cross3(f, lin) + cross3(n, ang);
   }
   // Subtree sums, children before parents (pre-order positions, read backwards).
   for (int i = nb - 1; i > 0; --i) {
@@ -102,49 +107,66 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
     d.inertiaTimesAcceleration[p] += d.inertiaTimesAcceleration[i];
     d.wrench[p] += d.wrench[i];
   }
-  for (int k = 1; k < nb; ++k) {
-    const Vector6& sk = d.motion[k];
-    const Terms& t = d.terms[k];
-    d.alpha[k] = forceCross(sk, d.wrench[k] - d.inertiaTimesAcceleration[k]) - momentumCouplingTimes(t, sk);
-    d.beta[k] = -inertiaTimes(t, sk);
-    d.gamma[k] = velocityCouplingTimes(t, d.momentum[k].head<3>(), sk) + forceCross(sk, d.momentum[k]);
-  }
-
-  for (int pj = 1; pj < nb; ++pj) {
-    const Vector6& sj = d.motion[pj];
-    const Vector6& vj = d.twist[pj];
-    const Terms& t = d.terms[pj];
-    const Vector3 linearMomentum = d.momentum[pj].head<3>();
+  // Per joint j: its row factors (α, β, γ), its column factors and G_j; the diagonal entries.
+  for (int j = 1; j < nb; ++j) {
+    const Vector6& sj = d.motion[j];
+    const Vector6& vj = d.twist[j];
+    const Terms& t = d.terms[j];
+    const Vector6& h = d.momentum[j];
+    const Vector6& pj = d.inertiaTimesAcceleration[j];
+    const Vector3 linearMomentum = h.head<3>();
+    const Vector6 ys = velocityCouplingTimes(t, linearMomentum, sj);  // Y S
+    const Vector6 zs = momentumCouplingTimes(t, sj);                  // Z S
+    const Vector6 sh = forceCross(sj, h);                             // S ×* h
+    const Vector6 is = inertiaTimes(t, sj);                           // I S
+    const Vector6 alpha = forceCross(sj, d.wrench[j] - pj) - zs;
+    const Vector6 gamma = ys + sh;
     const Vector6 cj = motionCross(sj, vj);
-    const Vector6 uj = motionCross(sj, d.acceleration[pj]) + motionCross(vj, cj);
-    const Vector6 ej = motionCross(sj, vj + d.twist[edges[pj].parent]);
-    const int column = edges[pj].joint;
-    // The subtree of j: three dot products a joint.
-    for (int k = pj; k < model.subtreeEnd(pj); ++k) {
-      const int row = edges[k].joint;
-      d.dtauDq(row, column) = sj.dot(d.alpha[k]) + uj.dot(d.beta[k]) + cj.dot(d.gamma[k]);
-      d.dtauDv(row, column) = ej.dot(d.beta[k]) - sj.dot(d.gamma[k]);
-    }
+    const Vector6 uj = motionCross(sj, d.acceleration[j]) + motionCross(vj, cj);
+    const Vector6 ej = motionCross(sj, vj + d.twist[edges[j].parent]);
+    auto rows = d.rowFactors.col(j);
+    rows.segment<6>(0) = alpha;
+    rows.segment<6>(6) = -is;
+    rows.segment<6>(12) = gamma;
+    auto factors = d.columnFactors.col(j);
+    factors.segment<6>(0) = uj;
+    factors.segment<6>(6) = cj;
+    factors.segment<6>(12) = ej;
     // Between j and the reference body: S_a · G_j, and W0 takes G_j.
-    const Vector6 gq = forceCross(sj, d.inertiaTimesAcceleration[pj]) - inertiaTimes(t, uj) +
-                       velocityCouplingTimes(t, linearMomentum, cj) + momentumCouplingTimes(t, sj) -
-                       forceCross(cj, d.momentum[pj]);
-    const Vector6 gv =
-        forceCross(sj, d.momentum[pj]) - velocityCouplingTimes(t, linearMomentum, sj) - inertiaTimes(t, ej);
-    // ∂/∂q̈_j: the mass matrix, CRBA-style: F = Iᶜ_j S_j, M(a, j) = M(j, a) = S_a · F.
-    const Vector6 ga = -d.beta[pj];
-    for (int p = edges[pj].parent; p > 0; p = edges[p].parent) {
-      const int row = edges[p].joint;
-      d.dtauDq(row, column) = d.motion[p].dot(gq);
-      d.dtauDv(row, column) = d.motion[p].dot(gv);
-      const double mass = d.motion[p].dot(ga);
-      d.dtauDa(row, column) = mass;
+    auto g = d.subtreeWrench.col(j);
+    g.segment<6>(0) = forceCross(sj, pj) - inertiaTimes(t, uj) + velocityCouplingTimes(t, linearMomentum, cj) + zs -
+                      forceCross(cj, h);
+    g.segment<6>(6) = sh - ys - inertiaTimes(t, ej);
+    g.segment<6>(12) = is;  // ∂/∂q̈_j: the mass matrix, CRBA-style: M(a, j) = S_a · Iᶜ_j S_j
+    const int column = d.jointAt[j];
+    d.dtauDq(column, column) = sj.dot(alpha) + uj.dot(rows.segment<6>(6)) + cj.dot(gamma);
+    d.dtauDv(column, column) = ej.dot(rows.segment<6>(6)) - sj.dot(gamma);
+    d.dtauDa(column, column) = sj.dot(is);
+    d.dwrenchDq.col(column) = g.segment<6>(0);
+    d.dwrenchDv.col(column) = g.segment<6>(6);
+    d.dwrenchDa.col(column) = is;
+  }
+  // Each pair of a joint j and a joint k it carries (k in the subtree of j, k ≠ j): the
+  // subtree's rows, ∂Γ_k/∂q_j = S_j·α_k + u_j·β_k + c_j·γ_k and ∂Γ_k/∂q̇_j = e_j·β_k − S_j·γ_k,
+  // and the other way, ∂Γ_j/∂(q_k, q̇_k, q̈_k) = S_j · G_k (the mass matrix's both entries).
+  for (int j = 1; j < nb; ++j) {
+    const int column = d.jointAt[j];
+    const Vector6 sj = d.motion[j];
+    const Vector6 uj = d.columnFactors.col(j).segment<6>(0);
+    const Vector6 cj = d.columnFactors.col(j).segment<6>(6);
+    const Vector6 ej = d.columnFactors.col(j).segment<6>(12);
+    for (int k = j + 1; k < model.subtreeEnd(j); ++k) {
+      const int row = d.jointAt[k];
+      const auto rows = d.rowFactors.col(k);
+      const auto g = d.subtreeWrench.col(k);
+      d.dtauDq(row, column) = sj.dot(rows.segment<6>(0)) + uj.dot(rows.segment<6>(6)) + cj.dot(rows.segment<6>(12));
+      d.dtauDv(row, column) = ej.dot(rows.segment<6>(6)) - sj.dot(rows.segment<6>(12));
+      d.dtauDq(column, row) = sj.dot(g.segment<6>(0));
+      d.dtauDv(column, row) = sj.dot(g.segment<6>(6));
+      const double mass = sj.dot(g.segment<6>(12));
       d.dtauDa(column, row) = mass;
+      d.dtauDa(row, column) = mass;
     }
-    d.dtauDa(column, column) = sj.dot(ga);
-    d.dwrenchDq.col(column) = gq;
-    d.dwrenchDv.col(column) = gv;
-    d.dwrenchDa.col(column) = ga;
   }
 }
 
@@ -153,7 +175,7 @@ void wrenchDerivativeAtReferenceFrame(const DynamicsModel& model,
                                       Eigen::Matrix<double, 6, Eigen::Dynamic>& out) {
   out = atOrigin;
   const Vector3& p = model.referencePose().translation;
-  for (Eigen::Index c = 0; c < out.cols(); ++c) out.col(c).tail<3>() -= p.cross(Vector3(atOrigin.col(c).head<3>()));
+  for (Eigen::Index c = 0; c < out.cols(); ++c) out.col(c).tail<3>() -= cross3(p, Vector3(atOrigin.col(c).head<3>()));
 }
 
 }  // namespace mcopt

@@ -21,9 +21,10 @@
 // the joints between j and the reference body get S_a · Gⱼ with Gⱼ the subtree sum at j:
 //   G_j^q = S_j ×* Pᶜ_j − Iᶜ_j u_j + Yᶜ_j c_j + Zᶜ_j S_j − c_j ×* Hᶜ_j = ∂W0/∂q_j
 //   G_j^v = −Yᶜ_j S_j + S_j ×* Hᶜ_j − Iᶜ_j e_j = ∂W0/∂q̇_j
-// ∂Γ/∂q̈ is the mass matrix (CRBA). Per sample: O(bodies) work, then three dot products per
-// (joint, descendant) pair — the organisation of Carpentier & Mansard's analytical RNEA
-// derivatives (RSS 2018), derived here for the rooted world-frame recursion.
+// ∂Γ/∂q̈ is the mass matrix (CRBA). Per sample: O(bodies) work, then five dot products of
+// 6-vectors per (joint, descendant) pair, read from contiguous per-joint columns — the
+// organisation of Carpentier & Mansard's analytical RNEA derivatives (RSS 2018), derived here
+// for the rooted world-frame recursion.
 //
 // No 6 × 6 matrix is formed. In 3 × 3 blocks, with V = (v, ω), h = (f, n) = I V:
 //   I = [[m, −[mc]×], [[mc]×, J]]              (J: rotational inertia about the origin)
@@ -58,7 +59,13 @@ struct DynamicsDerivatives {
   std::vector<BodyTerms> terms;
   std::vector<Vector6> motion, twist, acceleration;   ///< S_i, V_i, A_i
   std::vector<Vector6> momentum, inertiaTimesAcceleration, wrench;  ///< h_i, P_i, F_i, then their subtree sums
-  std::vector<Vector6> alpha, beta, gamma;       ///< per joint k (by position), see above
+  /// Column k: (α_k, β_k, γ_k) of joint k's row (see above).
+  Eigen::Matrix<double, 18, Eigen::Dynamic> rowFactors;
+  /// Column j: (u_j, c_j, e_j), joint j's factors of ∂Γ/∂q and ∂Γ/∂q̇ below it (with S_j).
+  Eigen::Matrix<double, 18, Eigen::Dynamic> columnFactors;
+  /// Column j: (G_j^q, G_j^v, G_j^a), the subtree wrench's derivatives in q_j, q̇_j, q̈_j.
+  Eigen::Matrix<double, 18, Eigen::Dynamic> subtreeWrench;
+  std::vector<int> jointAt;  ///< the joint of each tree position (treeJoints()[k].joint), contiguous
 };
 
 /// Runs inverseDynamics (filling `data`) and its derivatives (filling `derivatives`).

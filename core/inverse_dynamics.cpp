@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: BSD-3-Clause
 #include "core/inverse_dynamics.hpp"
 
+#include <cmath>
+
 #include "core/hot_path_checks.hpp"
+#include "core/spatial_algebra.hpp"
 
 namespace mcopt {
 
@@ -18,7 +21,7 @@ DynamicsData::DynamicsData(const DynamicsModel& model) {
 namespace {
 
 // rotation ← rotation · Rot(e_k, angle) for a coordinate axis: two columns mix.
-inline void rotateAboutCoordinateAxis(Matrix3& rotation, int k, double s, double c) {
+MCOPT_ALWAYS_INLINE void rotateAboutCoordinateAxis(Matrix3& rotation, int k, double s, double c) {
   const int i = (k + 1) % 3, j = (k + 2) % 3;  // Rot(e_k) turns e_i toward e_j
   const Vector3 ci = rotation.col(i), cj = rotation.col(j);
   rotation.col(i) = c * ci + s * cj;
@@ -28,38 +31,41 @@ inline void rotateAboutCoordinateAxis(Matrix3& rotation, int k, double s, double
 // Pose of the body at `i` from its parent's (formulation.md (3.2)–(3.5)). Placements that
 // are pure translations (most of them) skip the rotation products; joints about a
 // coordinate axis rotate two columns: this halves the cost of a sample (measured).
-inline void placeBody(const TreeJoint& edge, double qj, DynamicsData& d, int i) {
-  const int p = edge.parent;
-  Matrix3 jointRotation = d.rotation[p];
-  Vector3 jointOrigin = d.position[p];
-  if (!edge.beforeIsIdentity) {
-    jointOrigin.noalias() += d.rotation[p] * edge.before.translation;
-    if (!edge.beforeIsTranslation) jointRotation = d.rotation[p] * edge.before.rotation;
+MCOPT_ALWAYS_INLINE void placeBody(const TreeJoint& edge, double qj, DynamicsData& d, int i) {
+  const Matrix3& parentRotation = d.rotation[edge.parent];
+  Matrix3& rotation = d.rotation[i];  // built in place: the joint frame's, then the body's
+  Vector3 jointOrigin = d.position[edge.parent];
+  if (edge.beforeIsIdentity) {
+    rotation = parentRotation;
+  } else {
+    jointOrigin.noalias() += parentRotation * edge.before.translation;
+    if (edge.beforeIsTranslation)
+      rotation = parentRotation;
+    else
+      rotation.noalias() = parentRotation * edge.before.rotation;
   }
   const Vector3 axis =
-      edge.axisIndex >= 0 ? Vector3(edge.axisSign * jointRotation.col(edge.axisIndex)) : Vector3(jointRotation * edge.axis);
+      edge.axisIndex >= 0 ? Vector3(edge.axisSign * rotation.col(edge.axisIndex)) : Vector3(rotation * edge.axis);
   d.jointAxis[i] = axis;
   if (edge.prismatic) {
     jointOrigin += qj * axis;
     d.jointMoment[i] = axis;
   } else {
-    d.jointMoment[i] = jointOrigin.cross(axis);
+    d.jointMoment[i] = cross3(jointOrigin, axis);
     if (edge.axisIndex >= 0) {
-      rotateAboutCoordinateAxis(jointRotation, edge.axisIndex, edge.axisSign * std::sin(qj), std::cos(qj));
+      double sine = 0.0, cosine = 1.0;
+      ::sincos(qj, &sine, &cosine);  // one call for both (GCC merges sin and cos only without errno)
+      rotateAboutCoordinateAxis(rotation, edge.axisIndex, edge.axisSign * sine, cosine);
     } else {
-      jointRotation = jointRotation * rotationAboutAxis(edge.axis, qj);
+      rotation = rotation * rotationAboutAxis(edge.axis, qj);
     }
   }
   if (edge.afterIsIdentity) {
-    d.rotation[i] = jointRotation;
     d.position[i] = jointOrigin;
   } else {
-    d.position[i].noalias() = jointRotation * edge.after.translation;
+    d.position[i].noalias() = rotation * edge.after.translation;
     d.position[i] += jointOrigin;
-    if (edge.afterIsTranslation)
-      d.rotation[i] = jointRotation;
-    else
-      d.rotation[i].noalias() = jointRotation * edge.after.rotation;
+    if (!edge.afterIsTranslation) rotation = rotation * edge.after.rotation;
   }
 }
 
@@ -112,13 +118,13 @@ void inverseDynamics(const DynamicsModel& model, DynamicsData& d, const ConstVec
       const double qdd = a[edge.joint];
       placeBody(edge, q[edge.joint], d, i);
       const Vector3 sLin = d.jointMoment[i];
-      Vector3 sAng = d.jointAxis[i];
-      if (edge.prismatic) sAng.setZero();
-      d.linearVelocity[i] = d.linearVelocity[p] + qd * sLin;
-      d.angularVelocity[i] = d.angularVelocity[p] + qd * sAng;
-      d.linearAcceleration[i] = d.linearAcceleration[p] + qdd * sLin +
-                                qd * (d.angularVelocity[i].cross(sLin) + d.linearVelocity[i].cross(sAng));
-      d.angularAcceleration[i] = d.angularAcceleration[p] + qdd * sAng + qd * d.angularVelocity[i].cross(sAng);
+      const Vector3 sAng = edge.prismatic ? Vector3::Zero() : d.jointAxis[i];
+      const Vector3 lin = d.linearVelocity[p] + qd * sLin;
+      const Vector3 ang = d.angularVelocity[p] + qd * sAng;
+      d.linearVelocity[i] = lin;
+      d.angularVelocity[i] = ang;
+      d.linearAcceleration[i] = d.linearAcceleration[p] + qdd * sLin + qd * (cross3(ang, sLin) + cross3(lin, sAng));
+      d.angularAcceleration[i] = d.angularAcceleration[p] + qdd * sAng + qd * cross3(ang, sAng);
     }
     // Body wrench, Newton–Euler about the com, moved to the world origin.
     const BodyInertia& inertia = inertias[i];
@@ -127,13 +133,13 @@ void inverseDynamics(const DynamicsModel& model, DynamicsData& d, const ConstVec
     d.comPosition[i] = com;
     const Vector3& w = d.angularVelocity[i];
     const Vector3& dw = d.angularAcceleration[i];
-    const Vector3 comVelocity = d.linearVelocity[i] + w.cross(com);
-    const Vector3 comAcceleration = d.linearAcceleration[i] + dw.cross(com) + w.cross(comVelocity);
+    const Vector3 comVelocity = d.linearVelocity[i] + cross3(w, com);
+    const Vector3 comAcceleration = d.linearAcceleration[i] + cross3(dw, com) + cross3(w, comVelocity);
     const Vector3 wLocal = R.transpose() * w;
     const Vector3 dwLocal = R.transpose() * dw;
-    const Vector3 torqueLocal = inertia.inertiaAboutCom * dwLocal + wLocal.cross(inertia.inertiaAboutCom * wLocal);
+    const Vector3 torqueLocal = inertia.inertiaAboutCom * dwLocal + cross3(wLocal, Vector3(inertia.inertiaAboutCom * wLocal));
     d.force[i] = inertia.mass * comAcceleration;
-    d.moment[i] = R * torqueLocal + com.cross(d.force[i]);
+    d.moment[i] = R * torqueLocal + cross3(com, d.force[i]);
   }
 
   // Backward recursion: accumulate toward the reference body; Γ_j = sv·F + sw·M (3.6).
