@@ -19,8 +19,6 @@ DynamicsDerivatives::DynamicsDerivatives(const DynamicsModel& model) {
   rowFactors.setZero(18, model.bodyCount());
   columnFactors.setZero(18, model.bodyCount());
   subtreeWrench.setZero(18, model.bodyCount());
-  jointAt.assign(nb, -1);
-  for (int k = 1; k < model.bodyCount(); ++k) jointAt[static_cast<std::size_t>(k)] = model.treeJoints()[k].joint;
 }
 
 namespace {
@@ -138,7 +136,7 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
                       forceCross(cj, h);
     g.segment<6>(6) = sh - ys - inertiaTimes(t, ej);
     g.segment<6>(12) = is;  // ∂/∂q̈_j: the mass matrix, CRBA-style: M(a, j) = S_a · Iᶜ_j S_j
-    const int column = d.jointAt[j];
+    const int column = model.jointAtPosition(j);
     d.dtauDq(column, column) = sj.dot(alpha) + uj.dot(rows.segment<6>(6)) + cj.dot(gamma);
     d.dtauDv(column, column) = ej.dot(rows.segment<6>(6)) - sj.dot(gamma);
     d.dtauDa(column, column) = sj.dot(is);
@@ -150,13 +148,13 @@ void inverseDynamicsDerivatives(const DynamicsModel& model, DynamicsData& data, 
   // subtree's rows, ∂Γ_k/∂q_j = S_j·α_k + u_j·β_k + c_j·γ_k and ∂Γ_k/∂q̇_j = e_j·β_k − S_j·γ_k,
   // and the other way, ∂Γ_j/∂(q_k, q̇_k, q̈_k) = S_j · G_k (the mass matrix's both entries).
   for (int j = 1; j < nb; ++j) {
-    const int column = d.jointAt[j];
+    const int column = model.jointAtPosition(j);
     const Vector6 sj = d.motion[j];
     const Vector6 uj = d.columnFactors.col(j).segment<6>(0);
     const Vector6 cj = d.columnFactors.col(j).segment<6>(6);
     const Vector6 ej = d.columnFactors.col(j).segment<6>(12);
     for (int k = j + 1; k < model.subtreeEnd(j); ++k) {
-      const int row = d.jointAt[k];
+      const int row = model.jointAtPosition(k);
       const auto rows = d.rowFactors.col(k);
       const auto g = d.subtreeWrench.col(k);
       d.dtauDq(row, column) = sj.dot(rows.segment<6>(0)) + uj.dot(rows.segment<6>(6)) + cj.dot(rows.segment<6>(12));

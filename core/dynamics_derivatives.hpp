@@ -65,7 +65,6 @@ struct DynamicsDerivatives {
   Eigen::Matrix<double, 18, Eigen::Dynamic> columnFactors;
   /// Column j: (G_j^q, G_j^v, G_j^a), the subtree wrench's derivatives in q_j, q̇_j, q̈_j.
   Eigen::Matrix<double, 18, Eigen::Dynamic> subtreeWrench;
-  std::vector<int> jointAt;  ///< the joint of each tree position (treeJoints()[k].joint), contiguous
 };
 
 /// Runs inverseDynamics (filling `data`) and its derivatives (filling `derivatives`).

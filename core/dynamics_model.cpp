@@ -83,6 +83,8 @@ DynamicsModel::DynamicsModel(RobotModel robot, const std::string& referenceFrame
   }
   inertias_.resize(nb);
   for (int position = 0; position < nb; ++position) inertias_[position] = robot_.bodies[bodyAtPosition_[position]].inertia;
+  jointAtPosition_.assign(nb, -1);
+  for (int position = 1; position < nb; ++position) jointAtPosition_[position] = treeJoints_[position].joint;
 }
 
 bool DynamicsModel::supports(int joint, int position) const {

@@ -54,6 +54,9 @@ class DynamicsModel {
   int positionOfBody(int body) const { return positionOfBody_[body]; }
   /// Tree position of the body that joint j moves away from the reference body.
   int positionOfJoint(int joint) const { return positionOfJoint_[joint]; }
+  /// The joint into the body at `position` (treeJoints()[position].joint, from a contiguous
+  /// array for the per-sample loops); −1 at the reference body.
+  int jointAtPosition(int position) const { return jointAtPosition_[position]; }
 
   int referenceFrame() const { return referenceFrame_; }
   const RigidTransform& referencePose() const { return referencePose_; }
@@ -74,7 +77,7 @@ class DynamicsModel {
   RobotModel robot_;
   std::vector<TreeJoint> treeJoints_;
   std::vector<BodyInertia> inertias_;
-  std::vector<int> bodyAtPosition_, positionOfBody_, positionOfJoint_, subtreeEnd_;
+  std::vector<int> bodyAtPosition_, positionOfBody_, positionOfJoint_, jointAtPosition_, subtreeEnd_;
   int referenceFrame_ = 0;
   RigidTransform referencePose_, rootPose_;
   Vector3 gravity_;
