@@ -55,7 +55,7 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
         # --max-iterations 1 bounds each continuation stage (every bundled scenario has two: a
         # Gauss–Newton stage, then sample-differences; the weight shift's first is for the
         # bilevel formulation alone; the kick's are the smooth maximum's Gauss–Newton stage, then
-        # its epigraph form with the exact Hessian).
+        # its epigraph form with sample differences).
         assert run["status"] == "maximum_iterations" and run["iterations"] == run["stages"], label
         # The free-ends kick keeps the three stages the bundled kick had: the smooth maximum's
         # Gauss–Newton and sample-differences stages, then the epigraph form.
