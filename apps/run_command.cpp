@@ -175,7 +175,9 @@ int runMotion(const RunOptions& o) {
       else
         std::cout << ", epigraph";
       std::cout << ", " << solve.scenario.samples << " samples";
-      if (solve.problem.bilevel()) std::cout << ", inner solver " << solve.scenario.inner.solverName;
+      if (solve.problem.bilevel())
+        std::cout << ", inner solver " << solve.scenario.inner.solverName << ", " << toString(solve.scenario.inner.feasibility)
+                  << " row";
     }
     if (solve.problem.omittedTorqueRowCount() > 0)
       std::cout << "; " << solve.problem.omittedTorqueRowCount() << " torque-limit rows below " << scenario.solve.torqueScreening

@@ -267,6 +267,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"samples", stage.samples},
                       {"hessian", toString(stage.hessian)},
                       {"inner_solver", stage.innerSolver.empty() ? Json(nullptr) : Json(stage.innerSolver)},
+                      {"feasibility", stage.feasibility.empty() ? Json(nullptr) : Json(stage.feasibility)},
                       {"status", toString(stage.status)},
                       {"iterations", stage.iterations},
                       {"seconds", stage.seconds},

@@ -62,7 +62,10 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     stage.samples = stageScenario.samples;
     stage.hessian = stageScenario.solve.hessian;
     stage.energyForm = stageScenario.energyForm;
-    if (full.bilevel()) stage.innerSolver = stageScenario.inner.solverName;
+    if (full.bilevel()) {
+      stage.innerSolver = stageScenario.inner.solverName;
+      stage.feasibility = toString(stageScenario.inner.feasibility);
+    }
     OuterOutcome outcome;
     int joined = 0;
     for (;;) {

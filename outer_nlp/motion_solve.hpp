@@ -23,6 +23,7 @@ struct StageOutcome {
   HessianOption hessian = HessianOption::SampleDifferences;
   EnergyForm energyForm = EnergyForm::SmoothMaximum;
   std::string innerSolver;  ///< bilevel: the stage's inner solver; empty otherwise
+  std::string feasibility;  ///< bilevel: the stage's inner-feasibility row (slack, margin); empty otherwise
   OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
   double objective = 0.0;                           ///< of its last solve
   int iterations = 0;                               ///< over its rounds

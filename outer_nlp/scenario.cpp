@@ -372,8 +372,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
       yaml::rejectUnknownKeys(file, stage, field,
                               {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy",
-                               "for_contact_forces", "inner_solver"});
-      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}, {}};
+                               "for_contact_forces", "inner_solver", "feasibility"});
+      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}, {}, {}};
       if (stage["energy"]) {
         const std::string form = yaml::text(file, stage["energy"], field + ".energy");
         if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
@@ -420,6 +420,13 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
         if (!isInnerSolverName(c.innerSolver))
           throw InputError(where(file, inner, innerField) + "unknown inner solver '" + c.innerSolver + "' (expected " +
                            innerSolverList() + ")");
+      }
+      if (const YAML::Node row = stage["feasibility"]) {
+        const std::string rowField = field + ".feasibility";
+        if (s.contacts.empty())
+          throw InputError(where(file, row, rowField) +
+                           "the scenario has no contact besides the reference body's: no inner problem picks wrenches");
+        c.feasibility = readInnerFeasibility(file, row, rowField);
       }
       if (stage["max_iterations"]) c.maxIterations = yaml::integerAtLeast(file, stage["max_iterations"], field + ".max_iterations", 1);
       if (stage["friction_sharpness"])
@@ -476,6 +483,13 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                      "stage's inner_solver is barrier (inner.solver is " + s.inner.solverName + ")");
   if (const std::string why = marginModelRefusal(s); !why.empty())
     throw InputError(where(file, root["inner"]["feasibility"], "inner.feasibility") + why);
+  for (std::size_t k = 0; k < s.solve.continuation.size(); ++k) {
+    if (!s.solve.continuation[k].feasibility) continue;
+    if (const std::string why = marginModelRefusal(continuationStage(s, k)); !why.empty()) {
+      const std::string field = "continuation[" + std::to_string(k) + "].feasibility";
+      throw InputError(where(file, root["continuation"][k]["feasibility"], field) + why);
+    }
+  }
   return s;
 }
 

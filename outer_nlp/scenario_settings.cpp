@@ -42,6 +42,13 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
   }
 }
 
+InnerFeasibility readInnerFeasibility(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  const std::string name = yaml::text(file, node, field);
+  if (name == "margin") return InnerFeasibility::Margin;
+  if (name == "slack") return InnerFeasibility::Slack;
+  throw InputError(where(file, node, field) + "expected slack or margin, got '" + name + "'");
+}
+
 void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s) {
   yaml::rejectUnknownKeys(file, node, "inner", {"solver", "contact_model", "pyramid_facets", "kkt_backend", "tolerance", "polish", "barrier", "feasibility"});
   if (node["solver"]) {
@@ -74,12 +81,7 @@ void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node
   if (node["polish"]) s.inner.solver.polish = yaml::flag(file, node["polish"], "inner.polish");
   // Whether a solver reads it is checked once the continuation's stages are read (readScenario).
   if (node["barrier"]) s.inner.solver.barrier = yaml::positive(file, node["barrier"], "inner.barrier");
-  if (node["feasibility"]) {
-    const std::string name = yaml::text(file, node["feasibility"], "inner.feasibility");
-    if (name == "margin") s.inner.feasibility = InnerFeasibility::Margin;
-    else if (name == "slack") s.inner.feasibility = InnerFeasibility::Slack;
-    else throw InputError(where(file, node["feasibility"], "inner.feasibility") + "expected slack or margin, got '" + name + "'");
-  }
+  if (node["feasibility"]) s.inner.feasibility = readInnerFeasibility(file, node["feasibility"], "inner.feasibility");
   if (node["kkt_backend"]) {
     try {
       s.sensitivity.backend = parseKktBackend(yaml::text(file, node["kkt_backend"], "inner.kkt_backend"));
@@ -157,6 +159,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
     stage.solve.hessian = scenario.solve.continuation[k].hessian;
     stage.energyForm = scenario.solve.continuation[k].energyForm;
     if (!scenario.solve.continuation[k].innerSolver.empty()) stage.inner.solverName = scenario.solve.continuation[k].innerSolver;
+    if (scenario.solve.continuation[k].feasibility) stage.inner.feasibility = *scenario.solve.continuation[k].feasibility;
   }
   return stage;
 }
@@ -165,7 +168,7 @@ bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
   return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
          stage.samples == scenario.samples && stage.energyForm == scenario.energyForm &&
          (stage.contacts.empty() || !contactForceFormulation(stage.contactForces).innerProblem ||
-          stage.inner.solverName == scenario.inner.solverName);
+          (stage.inner.solverName == scenario.inner.solverName && stage.inner.feasibility == scenario.inner.feasibility));
 }
 
 namespace {
@@ -189,7 +192,7 @@ std::string barrierModelRefusal(const Scenario& s) {
 std::string marginModelRefusal(const Scenario& s) {
   if (s.inner.feasibility != InnerFeasibility::Margin) return {};
   const std::string cone = secondOrderConeModel(s);
-  return cone.empty() ? cone : "inner.feasibility: margin shifts the rows of linear contact models only (pyramid, wrench-cone): " + cone;
+  return cone.empty() ? cone : "the margin row shifts the rows of linear contact models only (pyramid, wrench-cone): " + cone;
 }
 
 }  // namespace mcopt

@@ -17,6 +17,7 @@
 namespace mcopt {
 
 struct Scenario;             // outer_nlp/scenario.hpp
+enum class InnerFeasibility;  // inner_qp/multi_contact_dynamics.hpp
 
 /// The `throw` task (formulation.md §10; docs/reference/scenario-file.md, "Throw"; outer_nlp/throw_task.cpp):
 /// `node` is tasks[i] with `kind: throw`; appends its two rows (BallFlightTask landing and
@@ -36,6 +37,9 @@ void readSolverOptions(const std::filesystem::path& file, const YAML::Node& node
 /// The `inner:` settings (scenario_settings.cpp): solver, contact model, facets, tolerance,
 /// polishing, KKT backend.
 void readInnerSettings(const std::filesystem::path& file, const YAML::Node& node, Scenario& s);
+/// An inner-feasibility row's name (`slack` or `margin`) at `node`: `inner.feasibility` or a
+/// continuation stage's `feasibility`, named `field` in the error.
+InnerFeasibility readInnerFeasibility(const std::filesystem::path& file, const YAML::Node& node, const std::string& field);
 
 /// loadScenario(file) for `root`, read from `file` and maybe changed since: `file` names it in
 /// messages, and its folder is where relative side-file paths start.

@@ -7,10 +7,15 @@
 // one of these (Scenario::solve); the motion problem is built from the problem and a Hessian
 // model (MotionProblemOptions), and the run (scenario_run.hpp, motion_solve.hpp) reads the rest.
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
 namespace mcopt {
+
+/// The bilevel inner-feasibility row (inner_qp/multi_contact_dynamics.hpp), declared here so that
+/// a stage can name one without this header pulling in the inner problem.
+enum class InnerFeasibility;
 
 /// The form of the energy's max(P, 0) (formulation.md §6): the problem's (Scenario::energyForm)
 /// or a continuation stage's.
@@ -85,6 +90,12 @@ struct ContinuationStage {
   /// test the exact optima's kinks can keep from passing (docs/theory/outer-problem.md,
   /// "Continuation").
   std::string innerSolver;
+  /// The bilevel outer row that keeps each sample's inner problem feasible in this stage
+  /// (`feasibility`); unset: the scenario's `inner.feasibility`. The slack row has no gradient
+  /// where it becomes active, so a stage whose optimum holds a sample's wrenches at the edge of
+  /// admissibility can end without a constraint qualification; the margin row has one there
+  /// (docs/theory/outer-problem.md, "Inner feasibility").
+  std::optional<InnerFeasibility> feasibility;
   /// Whether the stage runs with that formulation.
   bool runsWith(const std::string& forces) const {
     return forContactForces.empty() ||

@@ -799,13 +799,13 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"the margin row on second-order cones", [](YAML::Node& r) {
          r["inner"]["contact_model"] = "report";
          r["inner"]["feasibility"] = "margin";
-       }, {"inner.feasibility: margin shifts the rows of linear contact models only (pyramid, wrench-cone)",
+       }, {"inner.feasibility: the margin row shifts the rows of linear contact models only (pyramid, wrench-cone)",
            "the report model (inner.contact_model) has second-order friction cones"}},
       {"the margin row with a point hand", [](YAML::Node& r) {
          r["inner"]["contact_model"] = "wrench-cone";
          r["inner"]["feasibility"] = "margin";
          r["contacts"].push_back(YAML::Load("{surface: r_hand, model: point}"));
-       }, {"inner.feasibility: margin shifts the rows", "contact 'r_hand' has the point model"}},
+       }, {"inner.feasibility: the margin row shifts the rows", "contact 'r_hand' has the point model"}},
       {"missing file", [](YAML::Node& r) { r["actuators"] = "/nonexistent/actuators.yaml"; },
        {"actuators: file not found"}},
       {"unknown energy form", [](YAML::Node& r) { r["objective"]["energy"] = "max"; }, {"objective.energy: expected smooth_max or epigraph"}},
@@ -857,6 +857,19 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
          r["inner"]["contact_model"] = "report";
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: barrier}]");
        }, {"continuation[0].inner_solver: the barrier inner solver smooths linear contact models only",
+           "the report model (inner.contact_model) has second-order friction cones"}},
+      {"continuation stage's unknown feasibility row", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, feasibility: penalty}]");
+       }, {"continuation[0].feasibility: expected slack or margin, got 'penalty'"}},
+      {"continuation stage's feasibility row without a second contact", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, feasibility: margin}]");
+       }, {"continuation[0].feasibility: the scenario has no contact besides the reference body's"}},
+      {"continuation stage's margin row on second-order cones", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
+         r["inner"]["contact_model"] = "report";
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, feasibility: margin}]");
+       }, {"continuation[0].feasibility: the margin row shifts the rows of linear contact models only",
            "the report model (inner.contact_model) has second-order friction cones"}},
       {"continuation iteration limit not positive", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{max_iterations: 0}]");
@@ -1022,6 +1035,39 @@ TEST_CASE("run: a continuation stage's inner solver solves that stage and the sc
   INFO(r.all());
   CHECK(r.exitCode == 4);
   CHECK_THAT(r.output, Contains(", inner solver barrier") && Contains(", inner solver active-set"));
+}
+
+TEST_CASE("run: a continuation stage's feasibility row holds that stage, the scenario's inner.feasibility its own problem",
+          "[cli][run][multi-contact]") {
+  // The slack row in a Gauss–Newton stage, then the margin row for the scenario's problem (and
+  // the other way round), on the weight shift's 12 samples, one iteration a stage: result.json
+  // and the console name each stage's row, and a stage that names none takes the scenario's.
+  const test::TempDir dir;
+  struct Case {
+    std::string scenarioRow;        ///< inner.feasibility
+    std::string stageEntry;         ///< the stage's feasibility key, or empty
+    std::vector<std::string> rows;  ///< each stage's row in result.json
+  };
+  const std::vector<Case> cases = {{"margin", ", feasibility: slack", {"slack", "margin"}},
+                                   {"slack", ", feasibility: margin", {"margin", "slack"}},
+                                   {"margin", "", {"margin", "margin"}}};
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const auto staged = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
+      root["samples"] = 12;
+      root["inner"]["feasibility"] = cases[i].scenarioRow;
+      root["continuation"] = YAML::Load("[{hessian: gauss-newton" + cases[i].stageEntry + "}]");
+    }, "weight_shift_rows" + std::to_string(i) + ".yaml");
+    const auto out = dir.path() / ("rows" + std::to_string(i));
+    const auto r = test::runMcopt("run " + test::quoted(staged) + " --out " + test::quoted(out) + " --max-iterations 1");
+    INFO(cases[i].scenarioRow << cases[i].stageEntry << ": " << r.all());
+    REQUIRE(r.exitCode == 4);
+    const Json stages = readJson(out / "result.json")["continuation"];
+    REQUIRE(stages.size() == 2);
+    for (std::size_t k = 0; k < 2; ++k) {
+      CHECK(stages[k]["feasibility"] == cases[i].rows[k]);
+      CHECK_THAT(r.output, Contains("stage " + std::to_string(k + 1) + " of 2: ") && Contains(", " + cases[i].rows[k] + " row"));
+    }
+  }
 }
 
 TEST_CASE("run: knuckles on the table as a point contact: a force alone, recorded with its model", "[cli][run][multi-contact]") {

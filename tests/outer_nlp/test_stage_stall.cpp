@@ -92,3 +92,22 @@ TEST_CASE("continuation: a stage with another inner solver poses another problem
   s.contactForces = "variables";
   CHECK(posesScenarioProblem(continuationStage(s, 0), s));
 }
+
+TEST_CASE("continuation: a stage with another feasibility row poses another problem, only where an inner problem picks the wrenches",
+          "[outer][continuation]") {
+  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
+  s.inner.feasibility = InnerFeasibility::Margin;
+  s.solve.continuation.at(0).innerSolver.clear();  // the stage differs in its Hessian and its row only
+  s.solve.continuation.at(0).feasibility = InnerFeasibility::Slack;
+  const Scenario first = continuationStage(s, 0), own = continuationStage(s, s.solve.continuation.size());
+  CHECK(first.inner.feasibility == InnerFeasibility::Slack);
+  CHECK(own.inner.feasibility == InnerFeasibility::Margin);
+  CHECK_FALSE(posesScenarioProblem(first, s));  // its optimum does not end the run
+  // Unset: the scenario's row.
+  s.solve.continuation[0].feasibility.reset();
+  CHECK(continuationStage(s, 0).inner.feasibility == InnerFeasibility::Margin);
+  // Single-level formulations have no inner problem: the row does not tell two problems apart.
+  s.solve.continuation[0].feasibility = InnerFeasibility::Slack;
+  s.contactForces = "variables";
+  CHECK(posesScenarioProblem(continuationStage(s, 0), s));
+}
