@@ -166,6 +166,12 @@ int runMotion(const RunOptions& o) {
     if (solve.joinedTorqueRows > 0)
       std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.solve.torqueScreening
                 << " of their limit: solving again with them\n";
+    if (solve.restartedFrom >= 0)
+      std::cout << "  stage " << solve.restartedFrom + 1 << " ended worse than it began (violation " << std::setprecision(3)
+                << solve.handed.violation << " against " << solve.restart.violation << ", criterion " << std::setprecision(7)
+                << solve.handed.objective << " against " << solve.restart.objective << " in stage " << solve.stage + 1
+                << "'s problem): stage " << solve.stage + 1 << " starts where stage " << solve.restartedFrom + 1
+                << " started\n";
     std::cout << "motion optimisation (Ipopt, Hessian: " << toString(solve.scenario.solve.hessian);
     if (solve.stages > 1) {
       std::cout << "; stage " << solve.stage + 1 << " of " << solve.stages << ": ν = "

@@ -273,7 +273,8 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"seconds", stage.seconds},
                       {"objective", stage.objective},
                       {"screening_rounds", stage.rounds},
-                      {"torque_rows_checked_afterwards", stage.omittedTorqueRows}});
+                      {"torque_rows_checked_afterwards", stage.omittedTorqueRows},
+                      {"restarted_from_stage", stage.restartedFrom < 0 ? Json(nullptr) : Json(stage.restartedFrom + 1)}});
     totalIterations += stage.iterations;
   }
   result["continuation"] = stages;

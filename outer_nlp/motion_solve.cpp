@@ -36,6 +36,10 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
   const int stages = static_cast<int>(scenario.solve.continuation.size()) + 1;
   std::optional<Scenario> solved;  // the problem of the last stage that ended optimal
   Eigen::MatrixXd closureAngles;  // the closing joints' angles at each sample, handed from solve to solve
+  // The start of the last stage if it ended neither optimal nor stalled (stageEndDominated).
+  int unfinished = -1;
+  Eigen::VectorXd unfinishedStart;
+  Eigen::MatrixXd unfinishedAngles;
   for (int k = 0; k < stages; ++k) {
     const bool last = k + 1 == stages;
     const Scenario stageScenario = continuationStage(scenario, static_cast<std::size_t>(k));
@@ -53,10 +57,30 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     // exact epigraph form: docs/theory/outer-problem.md, "Continuation").
     full.startClosureAt(closureAngles);
     if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
+    // A stage that ended worse than it began hands on its start instead, judged in this
+    // stage's problem (each point on its own closure branch).
+    int restartedFrom = -1;
+    StagePoint handed, restart;
+    if (unfinished >= 0) {
+      Eigen::VectorXd start = unfinishedStart;
+      if (start.size() != full.variableCount()) start = full.pointFrom(problem, start);
+      handed = {full.violations(x).overall, full.objective(x)};
+      full.startClosureAt(unfinishedAngles);
+      restart = {full.violations(start).overall, full.objective(start)};
+      const bool endBroken = !std::isfinite(handed.objective) || !std::isfinite(handed.violation);
+      if (std::isfinite(restart.objective) && (endBroken || stageEndDominated(restart, handed))) {
+        x = start, closureAngles = unfinishedAngles, restartedFrom = unfinished;
+      }
+      full.startClosureAt(closureAngles);
+      unfinished = -1;
+    }
+    const Eigen::VectorXd stageStart = x;
+    const Eigen::MatrixXd stageStartAngles = closureAngles;
     std::vector<bool> omitted;
     const double screening = scenario.solve.torqueScreening;
     if (scenario.torqueLimits && screening > 0.0) omitted = full.torquesBelow(x, screening);
     StageOutcome stage;
+    stage.restartedFrom = restartedFrom;
     stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
     stage.smoothing = stageScenario.smoothing;
     stage.samples = stageScenario.samples;
@@ -72,7 +96,9 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       MotionProblem current(stageScenario, {stageScenario.solve.hessian, omitted});
       current.startClosureAt(closureAngles);  // the closure continues the motion's branch
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
-      if (events.onSolve) events.onSolve(SolveStart{k, stages, stageScenario, current, joined});
+      if (events.onSolve)
+        events.onSolve(SolveStart{k, stages, stageScenario, current, joined, stage.rounds == 0 ? restartedFrom : -1,
+                                  handed, restart});
       OuterSolverSettings roundSettings = settings;
       roundSettings.problemHessian = stageScenario.solve.hessian != HessianOption::LimitedMemory;
       // After the scenario's options: the stage's own limit wins.
@@ -147,6 +173,8 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       break;
     }
     if (usable && outcome.optimal()) solved = stageScenario;
+    if (usable && !outcome.optimal() && outcome.status != OuterStatus::Stalled)
+      unfinished = k, unfinishedStart = stageStart, unfinishedAngles = stageStartAngles;
     if (last || outcome.status == OuterStatus::Interrupted || !usable) {
       result.solver = outcome;
       if (!last) {

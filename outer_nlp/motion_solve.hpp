@@ -31,7 +31,26 @@ struct StageOutcome {
   SolveTimings timings;
   int rounds = 0;             ///< solves: 1 + the times torque-limit rows joined
   int omittedTorqueRows = 0;  ///< torque-limit rows out of the last solve, checked at its result
+  /// ≥ 0: this stage started from the point stage `restartedFrom` (0-based) had started from,
+  /// because that stage ended worse than it began (StagePoint, stageEndDominated); −1: from the
+  /// previous stage's iterate (or the run's start).
+  int restartedFrom = -1;
 };
+
+/// A point as the next stage's problem sees it: its largest row or bound violation and its
+/// criterion.
+struct StagePoint {
+  double violation = 0.0, objective = 0.0;
+};
+
+/// Whether a stage that ended neither optimal nor stalled made its point worse: its start is
+/// no worse than its end in both violation and criterion, both measured in the next stage's
+/// problem (the filter's order; docs/theory/outer-problem.md, "Continuation"). The next stage
+/// then starts from that start instead (measured: the throw's margin-row stage that fell into
+/// restoration, docs/developers/lab-notes/admissibility-margin.md).
+inline bool stageEndDominated(const StagePoint& start, const StagePoint& end) {
+  return start.violation <= end.violation && start.objective <= end.objective;
+}
 
 /// One Ipopt solve about to start.
 struct SolveStart {
@@ -39,6 +58,10 @@ struct SolveStart {
   const Scenario& scenario;      ///< the stage's scenario
   const MotionProblem& problem;  ///< what Ipopt solves (the screened problem)
   int joinedTorqueRows = 0;      ///< rows that joined since the previous round (0 on a stage's first)
+  /// ≥ 0 on a stage's first round: it starts from where stage `restartedFrom` started, whose end
+  /// (`handed`) that start (`restart`) dominated, both in this stage's problem.
+  int restartedFrom = -1;
+  StagePoint handed, restart;
 };
 
 struct MotionSolveEvents {

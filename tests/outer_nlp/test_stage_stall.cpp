@@ -3,7 +3,8 @@
 // docs/theory/outer-problem.md, "Continuation"): a window of regular iterations whose criterion
 // moves by at most its relative change, every one of them feasible; restoration iterates,
 // infeasible ones and steady progress restart or withhold it. And which stages pose the
-// scenario's own problem (continuationStage, posesScenarioProblem).
+// scenario's own problem (continuationStage, posesScenarioProblem), and when a stage that
+// ended worse than it began hands on its start (stageEndDominated).
 #include <catch2/catch.hpp>
 
 #include "common/test_support.hpp"
@@ -70,6 +71,22 @@ TEST_CASE("stage stall: a flat feasible window hands on, progress and infeasible
     CHECK(stalledAt(watch, small) == 10);
   }
   CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{1, 1e-6, 1e-6}));
+}
+
+TEST_CASE("continuation: a stage that ended worse than it began hands on its start, in the filter's order",
+          "[outer][continuation]") {
+  // Throw 41 (1.4 s, 6 m, 0.7 m left) with a margin-row stage between: the Gauss–Newton
+  // stage's end, then that stage's end in restoration, both in the last stage's problem.
+  const StagePoint gaussNewtonEnd{2.4e-5, 183.52}, restorationEnd{7.4e-3, 239.11};
+  CHECK(stageEndDominated(gaussNewtonEnd, restorationEnd));
+  // Lower in one, higher in the other: the end is kept (the filter would accept it).
+  CHECK_FALSE(stageEndDominated({2.4e-5, 240.0}, restorationEnd));
+  CHECK_FALSE(stageEndDominated({1e-2, 183.52}, restorationEnd));
+  // The usual hand-over: a stage that started far from feasible and ended near an optimum.
+  CHECK_FALSE(stageEndDominated({6.98, 61.39}, {1.45e-4, 167.85}));
+  CHECK_FALSE(stageEndDominated({1e-3, 100.0}, {1e-9, 99.0}));
+  // Equal in both: nothing was gained, the start is as good.
+  CHECK(stageEndDominated(restorationEnd, restorationEnd));
 }
 
 TEST_CASE("continuation: a stage with another inner solver poses another problem, only where an inner problem picks the wrenches",

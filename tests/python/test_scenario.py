@@ -139,8 +139,9 @@ def test_the_chosen_formulation_is_the_one_the_files_checks_see(mcopt_exe, tmp_p
     # A file that asks for it (written around the checks: the saved throw, its line edited).
     s.save(tmp_path / "throw.yaml")
     text = (tmp_path / "throw.yaml").read_text()
-    assert text.count("hessian: sample-differences") == 1
-    (tmp_path / "exact.yaml").write_text(text.replace("hessian: sample-differences", "hessian: exact"))
+    # The scenario's own line (a continuation stage of the throw names sample differences too).
+    assert text.count("\nhessian: sample-differences") == 1
+    (tmp_path / "exact.yaml").write_text(text.replace("\nhessian: sample-differences", "\nhessian: exact"))
     message = cli_error(mcopt_exe, "run", tmp_path / "exact.yaml", "--out", tmp_path / "o")
     assert "hessian: exact: the bilevel formulation" in message
     with pytest.raises(mcopt.InputError) as refused:
