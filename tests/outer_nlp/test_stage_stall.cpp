@@ -77,10 +77,10 @@ TEST_CASE("continuation: a stage that ended worse than it began hands on its sta
           "[outer][continuation]") {
   // Throw 41 (1.4 s, 6 m, 0.7 m left) with a margin-row stage between: the Gauss–Newton
   // stage's end, then that stage's end in restoration, both in the last stage's problem.
-  const StagePoint gaussNewtonEnd{2.4e-5, 183.52}, restorationEnd{7.4e-3, 239.11};
+  const StagePoint gaussNewtonEnd{1.52e-5, 183.5185}, restorationEnd{7.44e-3, 239.1124};
   CHECK(stageEndDominated(gaussNewtonEnd, restorationEnd));
   // Lower in one, higher in the other: the end is kept (the filter would accept it).
-  CHECK_FALSE(stageEndDominated({2.4e-5, 240.0}, restorationEnd));
+  CHECK_FALSE(stageEndDominated({1.52e-5, 240.0}, restorationEnd));
   CHECK_FALSE(stageEndDominated({1e-2, 183.52}, restorationEnd));
   // The usual hand-over: a stage that started far from feasible and ended near an optimum.
   CHECK_FALSE(stageEndDominated({6.98, 61.39}, {1.45e-4, 167.85}));
