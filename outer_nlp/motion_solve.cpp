@@ -12,7 +12,9 @@ namespace mcopt {
 
 StageStallWatch::StageStallWatch(Settings settings) : settings_(settings) {
   if (settings_.window < 2) throw InputError("stage stall watch: the window needs at least 2 iterations");
+  if (!(settings_.dualFall > 1.0)) throw InputError("stage stall watch: the dual infeasibility's fall needs a factor above 1");
   objectives_.assign(static_cast<std::size_t>(settings_.window), 0.0);
+  duals_.assign(static_cast<std::size_t>(settings_.window), 0.0);
 }
 
 bool StageStallWatch::stalled(const IterationReport& r) {
@@ -20,11 +22,17 @@ bool StageStallWatch::stalled(const IterationReport& r) {
     recorded_ = 0;
     return false;
   }
-  objectives_[static_cast<std::size_t>(recorded_ % settings_.window)] = r.objective;
+  const auto slot = static_cast<std::size_t>(recorded_ % settings_.window);
+  objectives_[slot] = r.objective;
+  duals_[slot] = r.dualInfeasibility;
   ++recorded_;
   if (recorded_ < settings_.window) return false;
   const auto [low, high] = std::minmax_element(objectives_.begin(), objectives_.end());
-  return *high - *low <= settings_.relativeChange * std::max(1.0, std::abs(r.objective));
+  if (*high - *low > settings_.relativeChange * std::max(1.0, std::abs(r.objective))) return false;
+  // The ring's oldest entry is the one the next iteration overwrites.
+  const double first = duals_[static_cast<std::size_t>(recorded_ % settings_.window)];
+  const bool converging = std::isfinite(r.dualInfeasibility) && r.dualInfeasibility * settings_.dualFall <= first;
+  return !converging;
 }
 
 MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, const Eigen::VectorXd& x0,

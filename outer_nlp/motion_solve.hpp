@@ -79,17 +79,22 @@ struct MotionSolveOutcome {
 /// Whether a stage before the scenario's own problem has stopped making progress
 /// (docs/theory/outer-problem.md, "Continuation"): over the last `window` regular iterations
 /// its criterion moved by at most `relativeChange` × max(1, |f|) while every iterate held its
-/// rows to `violation`. Such a stage hands its iterate on (status `stalled`) instead of
-/// running to its iteration limit: a stage whose Hessian model lacks a curvature the optimum
-/// needs can circle there for hundreds of iterations (measured on the throw with the margin
-/// row, docs/developers/lab-notes/admissibility-margin.md). Restoration iterates (another
-/// problem's) restart the window.
+/// rows to `violation`, and its dual infeasibility did not fall by `dualFall` from the
+/// window's first iterate to its last. Such a stage hands its iterate on (status `stalled`)
+/// instead of running to its iteration limit: a stage whose Hessian model lacks a curvature
+/// the optimum needs can circle there for hundreds of iterations (measured on the throw with
+/// the margin row, docs/developers/lab-notes/admissibility-margin.md), or creep, its dual
+/// infeasibility falling by a few per cent an iteration (the weight shift's Gauss–Newton
+/// stage). A stage converging to its own optimum has a flat criterion too, its dual
+/// infeasibility falling by orders of magnitude (the lean reach's last ten iterations), and
+/// is left to end optimal. Restoration iterates (another problem's) restart the window.
 class StageStallWatch {
  public:
   struct Settings {
-    int window = 25;
+    int window = 10;
     double relativeChange = 1e-6;
     double violation = 1e-6;
+    double dualFall = 10.0;
   };
   StageStallWatch() : StageStallWatch(Settings{}) {}
   explicit StageStallWatch(Settings settings);
@@ -98,7 +103,7 @@ class StageStallWatch {
 
  private:
   Settings settings_;
-  std::vector<double> objectives_;  ///< the window, a ring
+  std::vector<double> objectives_, duals_;  ///< the window, rings
   int recorded_ = 0;                ///< regular iterations in a row, with the violation held
 };
 

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // The hand-over of a stalled continuation stage (outer_nlp/motion_solve.hpp, StageStallWatch;
 // docs/theory/outer-problem.md, "Continuation"): a window of regular iterations whose criterion
-// moves by at most its relative change, every one of them feasible; restoration iterates,
-// infeasible ones and steady progress restart or withhold it. And which stages pose the
+// moves by at most its relative change, every one of them feasible, its dual infeasibility not
+// falling by the factor that says converging; restoration iterates, infeasible ones, steady
+// progress and convergence restart or withhold it. And which stages pose the
 // scenario's own problem (continuationStage, posesScenarioProblem), and when a stage that
 // ended worse than it began hands on its start (stageEndDominated).
 #include <catch2/catch.hpp>
+
+#include <limits>
 
 #include "common/test_support.hpp"
 #include "outer_nlp/motion_solve.hpp"
@@ -15,10 +18,10 @@ using namespace mcopt;
 
 namespace {
 
-IterationReport report(double objective, double violation, bool regular = true) {
+IterationReport report(double objective, double violation, bool regular = true, double dual = 1e-2) {
   static const Eigen::VectorXd iterate = Eigen::VectorXd::Zero(1);
   IterationReport r;
-  r.objective = objective, r.violation = violation;
+  r.objective = objective, r.violation = violation, r.dualInfeasibility = dual;
   r.iterate = regular ? &iterate : nullptr;
   return r;
 }
@@ -32,9 +35,9 @@ int stalledAt(StageStallWatch& watch, const std::vector<IterationReport>& report
 
 }  // namespace
 
-TEST_CASE("stage stall: a flat feasible window hands on, progress and infeasible or restoration iterates do not",
+TEST_CASE("stage stall: a flat feasible window hands on, progress, convergence, infeasible or restoration iterates do not",
           "[outer][continuation]") {
-  const StageStallWatch::Settings settings{10, 1e-6, 1e-6};
+  const StageStallWatch::Settings settings{10, 1e-6, 1e-6, 10.0};
   std::vector<IterationReport> flat;
   // The throw's plateau: 134.857559 … 134.857581 J, violations 1e-13 … 1e-7.
   for (int k = 0; k < 40; ++k) flat.push_back(report(134.857559 + (k % 3 == 0 ? 2.2e-5 : 0.0), k % 3 == 0 ? 4e-13 : 9e-8));
@@ -70,7 +73,45 @@ TEST_CASE("stage stall: a flat feasible window hands on, progress and infeasible
     StageStallWatch watch(settings);
     CHECK(stalledAt(watch, small) == 10);
   }
-  CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{1, 1e-6, 1e-6}));
+  {
+    // The weight shift's Gauss–Newton stage from its iteration 120: the criterion flat at
+    // 90.5052 J, the dual infeasibility creeping from 1.6e-1 to 1.4e-2 by a few per cent an
+    // iteration. Its first window falls by 14.7 (1.6e-1 to 1.1e-2: converging), the next by
+    // 3.7 (3.8e-2 to 1.0e-2): stalled there, at the 11th iteration, as the stage did at 130.
+    const std::vector<double> duals = {1.611e-1, 3.795e-2, 1.865e-2, 1.587e-2, 1.566e-2, 1.415e-2, 1.353e-2,
+                                       1.248e-2, 1.183e-2, 1.097e-2, 1.037e-2, 9.642e-3};
+    std::vector<IterationReport> creeping;
+    for (std::size_t k = 0; k < duals.size(); ++k)
+      creeping.push_back(report(90.505165 + (k % 2) * 1.2e-5, 1e-8, true, duals[k]));
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, creeping) == 11);
+  }
+  {
+    // The lean reach's last iterations: the criterion flat at 89.46646 J while the dual
+    // infeasibility falls from 1.0e-2 to 3.0e-5, Newton's method closing on the stage's own
+    // optimum. Not a stall: the stage is left to end optimal.
+    const std::vector<double> duals = {1.040e-2, 4.268e-2, 2.368e-3, 6.898e-4, 3.947e-4, 8.683e-5,
+                                       6.462e-5, 1.132e-5, 7.546e-5, 2.991e-5};
+    std::vector<IterationReport> converging;
+    for (std::size_t k = 0; k < duals.size(); ++k) converging.push_back(report(89.466459, 1e-9, true, duals[k]));
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, converging) == 0);
+    // Then the fall stops at 3e-5: stalled once a window falls by less than 10, from 8.7e-5
+    // (the window of the 6th to the 15th iteration: 2.9).
+    for (int k = 0; k < 10; ++k) converging.push_back(report(89.466459, 1e-9, true, 3e-5));
+    StageStallWatch again(settings);
+    CHECK(stalledAt(again, converging) == 15);
+  }
+  {
+    // A non-finite dual infeasibility is no convergence.
+    std::vector<IterationReport> reports = flat;
+    reports[9].dualInfeasibility = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t k = 0; k < 9; ++k) reports[k].dualInfeasibility = 1e3;
+    StageStallWatch watch(settings);
+    CHECK(stalledAt(watch, reports) == 10);
+  }
+  CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{1, 1e-6, 1e-6, 10.0}));
+  CHECK_THROWS(StageStallWatch(StageStallWatch::Settings{10, 1e-6, 1e-6, 1.0}));
 }
 
 TEST_CASE("continuation: a stage that ended worse than it began hands on its start, in the filter's order",
