@@ -643,7 +643,7 @@ TEST_CASE("run: a stage that ends worse than it began hands on its start, as if 
   // rows between its samples (4e-4 against 3e-7 at its start) and its criterion is higher, so
   // the scenario's problem starts where the middle stage started (docs/theory/outer-problem.md,
   // "Continuation"). It then takes the same iterates as a run without the middle stage: the
-  // same energy to the bit. (Two throws, ≈ 12 s in Release; too slow under the sanitizers.)
+  // same energy to the bit. (Two throws, ≈ 9 s in Release; too slow under the sanitizers.)
   if (kUnderSanitizers) return;
   const test::TempDir dir;
   Json results[2];
