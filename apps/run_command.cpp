@@ -166,6 +166,9 @@ int runMotion(const RunOptions& o) {
     if (solve.joinedTorqueRows > 0)
       std::cout << "  " << solve.joinedTorqueRows << " torque-limit rows came within " << scenario.solve.torqueScreening
                 << " of their limit: solving again with them\n";
+    if (solve.joinedClosingRows > 0)
+      std::cout << "  " << solve.joinedClosingRows << " closing joints' limit rows left the middle " << scenario.solve.closingScreening
+                << " of their range: solving again with them\n";
     if (solve.restartedFrom >= 0)
       std::cout << "  stage " << solve.restartedFrom + 1 << " ended worse than it began (violation " << std::setprecision(3)
                 << solve.handed.violation << " against " << solve.restart.violation << ", criterion " << std::setprecision(7)
@@ -188,6 +191,9 @@ int runMotion(const RunOptions& o) {
     if (solve.problem.omittedTorqueRowCount() > 0)
       std::cout << "; " << solve.problem.omittedTorqueRowCount() << " torque-limit rows below " << scenario.solve.torqueScreening
                 << " of their limit checked afterwards";
+    if (solve.problem.omittedClosingRowCount() > 0)
+      std::cout << "; " << solve.problem.omittedClosingRowCount() << " closing joints' limit rows inside the middle "
+                << solve.scenario.solve.closingScreening << " of their range checked afterwards";
     std::cout << ")\n"
               << "   iter      energy [J]   violation   dual inf.     elapsed"
               << (solve.problem.bilevel() ? "   infeasible samples" : "") << (scenario.ball ? "   miss [m]" : "") << "\n";
@@ -263,7 +269,7 @@ int runMotion(const RunOptions& o) {
     std::cout << ")";
   } else if (record.stages.size() == 1 && record.stages.front().rounds > 1) {
     // Rows that joined after an optimum were solved again: the last solve's count alone hides the others.
-    std::cout << " (" << record.stages.front().iterations << " over " << record.stages.front().rounds << " torque-screening solves)";
+    std::cout << " (" << record.stages.front().iterations << " over " << record.stages.front().rounds << " screening solves)";
   }
   std::cout << "\n"
             << "  time               " << record.totalSeconds << " s (configuration " << record.configurationSeconds

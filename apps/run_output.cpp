@@ -274,6 +274,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"objective", stage.objective},
                       {"screening_rounds", stage.rounds},
                       {"torque_rows_checked_afterwards", stage.omittedTorqueRows},
+                      {"closing_rows_checked_afterwards", stage.omittedClosingRows},
                       {"restarted_from_stage", stage.restartedFrom < 0 ? Json(nullptr) : Json(stage.restartedFrom + 1)}});
     totalIterations += stage.iterations;
   }
@@ -297,6 +298,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
   if (!record.stages.empty()) {
     result["solver"]["screening_rounds"] = record.stages.back().rounds;
     result["solver"]["torque_rows_checked_afterwards"] = record.stages.back().omittedTorqueRows;
+    result["solver"]["closing_rows_checked_afterwards"] = record.stages.back().omittedClosingRows;
   }
   Json fixed = Json::array();
   for (const PostureCheck& c : record.postureChecks) {

@@ -64,6 +64,7 @@ struct TermContext {
   const std::vector<std::vector<int>>& taskJoints;
   const std::vector<int>& torqueJoints;       ///< joints with a finite torque limit (when limited)
   const std::vector<bool>& omittedTorqueRows; ///< per sample and joint (s · n + j) left out; empty: none
+  const std::vector<bool>& omittedClosingRows; ///< per sample and closing detail (s · 2c + k) left out; empty: none
   const std::vector<int>& taskOfInstant;      ///< the task of each task instant
 };
 

@@ -119,11 +119,16 @@ class ClosingJointLimitTerm final : public SampleTermOfOneKind {
   explicit ClosingJointLimitTerm(const TermContext& c) : SampleTermOfOneKind(kClosingJointLimit), c_(c) {}
   void appendRows(RowSink& sink) const override {
     const int closing = c_.outputs.closing;
+    const auto omitted = [&](int detail) {
+      return !c_.omittedClosingRows.empty() &&
+             c_.omittedClosingRows[static_cast<std::size_t>(sink.block() * 2 * closing + detail)];
+    };
     for (int k = 0; k < closing; ++k) {
       const int joint = c_.closure->closingJoints()[static_cast<std::size_t>(k)];
       if (!c_.closure->closesIn(joint, sink.closed())) continue;  // a spline here: its control points' bounds
-      if (c_.scenario.positionLimits) sink.outputRow(k, c_.outputs.closingPosition(k), c_.allJoints, false);
-      if (c_.scenario.velocityLimits && std::isfinite(c_.scenario.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit))
+      if (c_.scenario.positionLimits && !omitted(k)) sink.outputRow(k, c_.outputs.closingPosition(k), c_.allJoints, false);
+      if (c_.scenario.velocityLimits && std::isfinite(c_.scenario.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit) &&
+          !omitted(closing + k))
         sink.outputRow(closing + k, c_.outputs.closingVelocity(k), c_.allJoints, false);
     }
   }

@@ -180,6 +180,9 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   omittedTorqueRows_ = std::move(options.omittedTorqueRows);
   if (!omittedTorqueRows_.empty() && omittedTorqueRows_.size() != static_cast<std::size_t>(jointCount_ * count))
     throw InputError("motion problem: the torque-row screening mask has the wrong size");
+  omittedClosingRows_ = std::move(options.omittedClosingRows);
+  if (!omittedClosingRows_.empty() && omittedClosingRows_.size() != static_cast<std::size_t>(2 * closing * count))
+    throw InputError("motion problem: the closing-joint-row screening mask has the wrong size");
   const int contacts = static_cast<int>(scenario_.contacts.size());
   outputs_.joints = jointCount_, outputs_.contacts = contacts;
   outputs_.contactRowStart = {0, support_.rowCount()};
@@ -290,7 +293,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
         unusedParameter_[static_cast<std::size_t>(j * m + l)] = !used[static_cast<std::size_t>(j * m + l)];
   }
   terms_ = makeConstraintTerms(TermContext{scenario_, parametrization_, outputs_, closure_.get(), support_, contactRows_, formulation_->innerProblem(),
-                                           relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_,
+                                           relatedJoints_, allJoints_, taskJoints_, torqueJoints_, omittedTorqueRows_, omittedClosingRows_,
                                            taskOfInstant_});
   costs_ = makeCostTerms(CostContext{scenario_, outputs_, closure_.get(), parametrization_, samples_, slackStart_});
   // The cost terms' own variables (the epigraph's slacks) come last.
@@ -332,6 +335,42 @@ int MotionProblem::omittedTorqueRowCount() const {
   int count = 0;
   for (int s = 0; s < samples_.sampleCount() && !omittedTorqueRows_.empty(); ++s)
     for (const int j : torqueJoints_) count += omittedTorqueRows_[static_cast<std::size_t>(s * jointCount_ + j)];
+  return count;
+}
+
+std::vector<bool> MotionProblem::closingLimitsBelow(const Eigen::VectorXd& x, double fraction) {
+  evaluate(x, false);
+  const int closing = outputs_.closing;
+  std::vector<bool> below(static_cast<std::size_t>(2 * closing * samples_.sampleCount()), true);
+  for (int s = 0; s < samples_.sampleCount(); ++s) {
+    const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
+    for (int k = 0; k < closing; ++k) {
+      const int joint = closure_->closingJoints()[static_cast<std::size_t>(k)];
+      if (!closure_->closesIn(joint, b.closed)) continue;  // no row: its spline's control points bound it
+      const JointLimits& range = scenario_.robot.joints[static_cast<std::size_t>(joint)].limits;
+      const double middle = 0.5 * (range.lower + range.upper), half = 0.5 * (range.upper - range.lower);
+      const std::size_t at = static_cast<std::size_t>(s * 2 * closing + k);
+      below[at] = std::abs(b.y[outputs_.closingPosition(k)] - middle) < fraction * half;  // false when unbounded (NaN)
+      const double limit = scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit;
+      below[at + static_cast<std::size_t>(closing)] = std::abs(b.y[outputs_.closingVelocity(k)]) < fraction * limit;
+    }
+  }
+  return below;
+}
+
+int MotionProblem::omittedClosingRowCount() const {
+  int count = 0;
+  for (int s = 0; s < samples_.sampleCount() && !omittedClosingRows_.empty(); ++s) {
+    const ClosureSet closed = blocks_[static_cast<std::size_t>(s)].closed;
+    for (int k = 0; k < 2 * outputs_.closing; ++k) {
+      const int joint = closure_->closingJoints()[static_cast<std::size_t>(k % outputs_.closing)];
+      const bool row = closure_->closesIn(joint, closed) &&
+                       (k < outputs_.closing ? scenario_.positionLimits
+                                             : scenario_.velocityLimits &&
+                                                   std::isfinite(scenario_.actuators.joints[static_cast<std::size_t>(joint)].velocityLimit));
+      count += row && omittedClosingRows_[static_cast<std::size_t>(s * 2 * outputs_.closing + k)];
+    }
+  }
   return count;
 }
 

@@ -135,6 +135,10 @@ struct MotionProblemOptions {
   /// docs/reference/scenario-file.md), where rows far from their bound are checked after the
   /// solve instead of weighing on every KKT factorisation.
   std::vector<bool> omittedTorqueRows{};
+  /// Empty, or one flag per sample and closing_joint_limit detail (index s · 2c + k: closing
+  /// joint k's position row for k < c, its velocity row for c ≤ k < 2c, c the closing joints):
+  /// those rows are left out (`limits.closing_screening`).
+  std::vector<bool> omittedClosingRows{};
   /// Whether the problem lays out its Jacobian (and can evaluate derivatives). Without it, only
   /// values: the objective, the rows, sampledPhysics, violations; a derivative asked for throws
   /// std::logic_error. For the fine grids of the energy balance and of `mcopt verify`
@@ -158,6 +162,11 @@ class MotionProblem final : public NlpProblem {
   /// (joints without a finite limit: true). For torque-limit screening.
   std::vector<bool> torquesBelow(const Eigen::VectorXd& x, double fraction);
   int omittedTorqueRowCount() const;
+  /// Per sample and closing_joint_limit detail (the index of omittedClosingRows): whether the
+  /// closing joint's position is within fraction · its half-range of the range's middle, and
+  /// its velocity below fraction · its limit, at x (true where the sample has no such row).
+  std::vector<bool> closingLimitsBelow(const Eigen::VectorXd& x, double fraction);
+  int omittedClosingRowCount() const;
   ~MotionProblem() override;
   const ContactAdmissibilityRows& support() const { return support_; }
 
@@ -500,6 +509,7 @@ class MotionProblem final : public NlpProblem {
   HessianOption hessian_;
   bool derivativesLaidOut_ = true;  ///< MotionProblemOptions::derivatives
   std::vector<bool> omittedTorqueRows_;   ///< per sample and joint, rows left out (screening)
+  std::vector<bool> omittedClosingRows_;  ///< per sample and closing detail, rows left out (screening)
   std::vector<int> allJoints_;
   std::vector<std::vector<int>> relatedJoints_;  ///< joints whose motion changes Γ_i: i's ancestors and descendants
   std::vector<std::vector<int>> taskJoints_;     ///< per task instant: joints that move the task's body

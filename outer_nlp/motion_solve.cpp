@@ -87,6 +87,10 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     std::vector<bool> omitted;
     const double screening = scenario.solve.torqueScreening;
     if (scenario.torqueLimits && screening > 0.0) omitted = full.torquesBelow(x, screening);
+    std::vector<bool> omittedClosing;
+    const double closingScreening = scenario.solve.closingScreening;
+    if ((scenario.positionLimits || scenario.velocityLimits) && closingScreening > 0.0 && !scenario.contacts.empty())
+      omittedClosing = full.closingLimitsBelow(x, closingScreening);
     StageOutcome stage;
     stage.restartedFrom = restartedFrom;
     stage.frictionSharpness = stageScenario.actuators.frictionSharpness;
@@ -99,14 +103,17 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       stage.feasibility = toString(stageScenario.inner.feasibility);
     }
     OuterOutcome outcome;
-    int joined = 0;
+    int joined = 0, joinedClosing = 0;
     for (;;) {
-      MotionProblem current(stageScenario, {stageScenario.solve.hessian, omitted});
+      MotionProblemOptions options{stageScenario.solve.hessian, omitted};
+      options.omittedClosingRows = omittedClosing;
+      MotionProblem current(stageScenario, std::move(options));
       current.startClosureAt(closureAngles);  // the closure continues the motion's branch
       stage.omittedTorqueRows = current.omittedTorqueRowCount();
+      stage.omittedClosingRows = current.omittedClosingRowCount();
       if (events.onSolve)
         events.onSolve(SolveStart{k, stages, stageScenario, current, joined, stage.rounds == 0 ? restartedFrom : -1,
-                                  handed, restart});
+                                  handed, restart, joinedClosing});
       OuterSolverSettings roundSettings = settings;
       roundSettings.problemHessian = stageScenario.solve.hessian != HessianOption::LimitedMemory;
       // After the scenario's options: the stage's own limit wins.
@@ -156,14 +163,20 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
       stage.iterations += outcome.iterations;
       stage.seconds += outcome.seconds;
       stage.timings += outcome.timings;
-      if (outcome.x.size() != x.size() || !outcome.x.allFinite() || !outcome.optimal() || omitted.empty()) break;
+      if (outcome.x.size() != x.size() || !outcome.x.allFinite() || !outcome.optimal() ||
+          (omitted.empty() && omittedClosing.empty()))
+        break;
       // Optimal for the rows in the problem, and for all of them when every omitted row is
       // still below its fraction (then strictly inside its bound: multiplier 0).
-      const std::vector<bool> below = full.torquesBelow(outcome.x, scenario.solve.torqueScreening);
-      joined = 0;
-      for (std::size_t i = 0; i < omitted.size(); ++i)
-        if (omitted[i] && !below[i]) omitted[i] = false, ++joined;
-      if (joined == 0) break;
+      const auto join = [](std::vector<bool>& out, const std::vector<bool>& below) {
+        int count = 0;
+        for (std::size_t i = 0; i < out.size(); ++i)
+          if (out[i] && !below[i]) out[i] = false, ++count;
+        return count;
+      };
+      joined = omitted.empty() ? 0 : join(omitted, full.torquesBelow(outcome.x, scenario.solve.torqueScreening));
+      joinedClosing = omittedClosing.empty() ? 0 : join(omittedClosing, full.closingLimitsBelow(outcome.x, closingScreening));
+      if (joined == 0 && joinedClosing == 0) break;
       x = outcome.x;
     }
     const bool usable = outcome.x.size() == x.size() && outcome.x.allFinite();

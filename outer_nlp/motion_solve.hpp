@@ -31,6 +31,7 @@ struct StageOutcome {
   SolveTimings timings;
   int rounds = 0;             ///< solves: 1 + the times torque-limit rows joined
   int omittedTorqueRows = 0;  ///< torque-limit rows out of the last solve, checked at its result
+  int omittedClosingRows = 0;  ///< closing joints' limit rows out of the last solve, checked at its result
   /// ≥ 0: this stage started from the point stage `restartedFrom` (0-based) had started from,
   /// because that stage ended worse than it began (StagePoint, stageEndDominated); −1: from the
   /// previous stage's iterate (or the run's start).
@@ -62,6 +63,7 @@ struct SolveStart {
   /// (`handed`) that start (`restart`) dominated, both in this stage's problem.
   int restartedFrom = -1;
   StagePoint handed, restart;
+  int joinedClosingRows = 0;  ///< closing joints' limit rows that joined since the previous round
 };
 
 struct MotionSolveEvents {

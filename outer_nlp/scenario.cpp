@@ -257,7 +257,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (root["limits"]) {
     const YAML::Node l = root["limits"];
     yaml::rejectUnknownKeys(file, l, "limits",
-                            {"position", "velocity", "torque", "torque_screening", "contact", "minimum_normal_force"});
+                            {"position", "velocity", "torque", "torque_screening", "closing_screening", "contact",
+                             "minimum_normal_force"});
     if (l["position"]) s.positionLimits = yaml::flag(file, l["position"], "limits.position");
     if (l["velocity"]) s.velocityLimits = yaml::flag(file, l["velocity"], "limits.velocity");
     if (l["torque"]) s.torqueLimits = yaml::flag(file, l["torque"], "limits.torque");
@@ -266,6 +267,12 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       if (s.solve.torqueScreening >= 1.0)
         throw InputError(where(file, l["torque_screening"], "limits.torque_screening") +
                          "expected a fraction of the limit in [0, 1) (0: every row in the problem)");
+    }
+    if (l["closing_screening"]) {
+      s.solve.closingScreening = yaml::nonNegative(file, l["closing_screening"], "limits.closing_screening");
+      if (s.solve.closingScreening >= 1.0)
+        throw InputError(where(file, l["closing_screening"], "limits.closing_screening") +
+                         "expected a fraction of the range in [0, 1) (0: every row in the problem)");
     }
     if (l["contact"]) s.contactConstraints = yaml::flag(file, l["contact"], "limits.contact");
     if (l["minimum_normal_force"])

@@ -114,6 +114,12 @@ struct SolveSettings {
   /// NLP and checked after the solve; rows that reach it join and the problem is solved
   /// again (docs/theory/outer-problem.md, "Torque-limit screening"). 0: every row in the NLP.
   double torqueScreening = 0.5;
+  /// The same for the position and velocity rows of the joints that close a contact (the
+  /// closing_joint_limit rows, one per joint and sample): a row whose value stays within this
+  /// fraction of its range about the range's middle (|q − mid| < f · half-range, |q̇| < f · limit)
+  /// is left out and checked after the solve (docs/theory/outer-problem.md, "Torque-limit
+  /// screening"). 0 (the default): every row in the NLP.
+  double closingScreening = 0.0;
   /// Configuration optimisation of the end postures before the motion (report §3.5), and its
   /// iteration cap (`initialisation:`).
   bool configurationOptimisation = true;

@@ -710,7 +710,7 @@ TEST_CASE("run: torque-limit screening solves again with the rows that came near
   // The summary counts every solve's iterations, not the last one's alone.
   const int total = result["solver"]["iterations_all_stages"].get<int>();
   CHECK(total > result["solver"]["iterations"].get<int>());
-  CHECK_THAT(r.output, Contains("(" + std::to_string(total) + " over " + std::to_string(rounds) + " torque-screening solves)"));
+  CHECK_THAT(r.output, Contains("(" + std::to_string(total) + " over " + std::to_string(rounds) + " screening solves)"));
   // At least `left` joint-samples are below the fraction of their limit, and none is beyond its limit.
   const RobotModel robot = loadUrdfFile(test::sourceDir() / "robots/hrp2/hrp2.urdf");
   const ActuatorSet actuators = loadActuators(test::sourceDir() / "robots/hrp2/actuators.yaml", robot);
@@ -725,6 +725,50 @@ TEST_CASE("run: torque-limit screening solves again with the rows that came near
   CHECK(below >= left);
   CHECK(worst <= 1.0);
   CHECK(result["max_violation"].get<double>() <= 1e-6);
+}
+
+TEST_CASE("run: closing-row screening solves again with the rows that left the middle of their range", "[cli][run]") {
+  // The weight shift on 20 samples in one solve (no continuation), its right leg's position and
+  // velocity rows left out while within 0.05 of their range's middle: it starts at rest in its
+  // posture, so rows leave that middle on the way and join; the run ends optimal with every row
+  // still left out inside it, checked on the result's own motion. (≈ 11 s in Release.)
+  if (kUnderSanitizers) return;
+  const test::TempDir dir;
+  const double fraction = 0.05;
+  const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [&](YAML::Node& root) {
+    root["samples"] = 20;
+    root.remove("continuation");
+    root["limits"]["closing_screening"] = fraction;
+  }, "weight_shift.yaml");
+  const auto out = dir.path() / "out";
+  const auto r = test::runMcopt("run " + test::quoted(scenario) + " --out " + test::quoted(out));
+  INFO(r.all());
+  REQUIRE(r.exitCode == 0);
+  CHECK_THAT(r.output, Contains("closing joints' limit rows left the middle 0.05 of their range: solving again with them"));
+  const Json result = readJson(out / "result.json");
+  CHECK(result["status"] == "optimal");
+  const int rounds = result["solver"]["screening_rounds"].get<int>(), left = result["solver"]["closing_rows_checked_afterwards"].get<int>();
+  CHECK(rounds >= 2);
+  CHECK(left > 0);
+  CHECK(result["violation_by_kind"]["closing_joint_limit"].get<double>() <= 1e-8);
+  // The right leg closes the right sole: at least `left` of its position and velocity values at
+  // the samples are inside the middle fraction, and none is beyond its limit.
+  const auto& names = result["joint_names"];
+  const auto& limits = result["joint_limits"];
+  int inside = 0;
+  double worst = 0.0;
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    if (names[j].get<std::string>().rfind("RLEG_", 0) != 0) continue;
+    const double lower = limits["position_lower"][j], upper = limits["position_upper"][j], speed = limits["velocity"][j];
+    for (std::size_t s = 0; s < 20; ++s) {
+      const double q = result["q"][s][j], v = result["v"][s][j];
+      inside += std::abs(q - 0.5 * (lower + upper)) < fraction * 0.5 * (upper - lower);
+      inside += std::abs(v) < fraction * speed;
+      worst = std::max({worst, q - upper, lower - q, std::abs(v) - speed});
+    }
+  }
+  CHECK(inside >= left);
+  CHECK(worst <= 1e-9);
 }
 
 TEST_CASE("run: every class of bad scenario is refused with file, line and field", "[cli][run]") {

@@ -5,10 +5,9 @@
 // the rows it leaves out are the ones whose |Γ| is below the fraction of their limit.
 #include <catch2/catch.hpp>
 
-#include <map>
 #include <random>
 
-#include "common/nlp_jacobian.hpp"
+#include "common/screened_rows.hpp"
 #include "common/test_support.hpp"
 #include "core/errors.hpp"
 #include "outer_nlp/motion_problem.hpp"
@@ -50,37 +49,9 @@ TEST_CASE("torque-limit screening: the screened problem is the full one without 
   screened.objectiveGradient(x, gradientScreened);
   CHECK(gradientScreened == gradientFull);
 
-  // Every remaining row, found in the full problem by its name (and which of the rows of that
-  // name it is: a joint's velocity-limit rows share one): the same value, bounds and Jacobian row.
-  auto keys = [](const MotionProblem& problem) {
-    std::vector<std::string> key;
-    std::map<std::string, int> seen;
-    for (int r = 0; r < problem.constraintCount(); ++r) {
-      const std::string name = problem.rowName(r);
-      key.push_back(name + "#" + std::to_string(seen[name]++));
-    }
-    return key;
-  };
-  const std::vector<std::string> fullKeys = keys(full), screenedKeys = keys(screened);
-  std::map<std::string, int> fullRows;
-  for (int r = 0; r < full.constraintCount(); ++r) fullRows[fullKeys[static_cast<std::size_t>(r)]] = r;
-  Eigen::VectorXd gFull, gScreened, lowerFull, upperFull, lowerScreened, upperScreened;
-  full.constraints(x, gFull);
-  screened.constraints(x, gScreened);
-  full.constraintBounds(lowerFull, upperFull);
-  screened.constraintBounds(lowerScreened, upperScreened);
-  const Eigen::MatrixXd jacobianFull = test::denseJacobian(full, x), jacobianScreened = test::denseJacobian(screened, x);
+  // Every remaining row: the same value, bounds and Jacobian row as in the full problem.
   int torqueRows = 0;
-  for (int r = 0; r < screened.constraintCount(); ++r) {
-    const auto found = fullRows.find(screenedKeys[static_cast<std::size_t>(r)]);
-    REQUIRE(found != fullRows.end());
-    const int f = found->second;
-    CHECK(gScreened[r] == gFull[f]);
-    CHECK(lowerScreened[r] == lowerFull[f]);
-    CHECK(upperScreened[r] == upperFull[f]);
-    CHECK((jacobianScreened.row(r) - jacobianFull.row(f)).cwiseAbs().maxCoeff() == 0.0);
-    torqueRows += screened.rowKind(r) == "torque_limit";
-  }
+  test::checkScreenedRows(full, screened, x, [&](int r, int) { torqueRows += screened.rowKind(r) == "torque_limit"; });
   CHECK(torqueRows == kept);
 
   CHECK_THROWS_AS(MotionProblem(s, {s.solve.hessian, std::vector<bool>(7, true)}), InputError);
