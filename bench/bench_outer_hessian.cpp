@@ -6,6 +6,9 @@
 // and the whole problem's gradient and Jacobian (OuterGradient/Kick100/hrp2), the unit
 // these options are counted in. OuterGradient/weight_shift/<formulation>[/<inner solver>]:
 // the same on the bundled weight shift for each contact-force formulation (formulation.md §9).
+// OuterHessian/<scenario>/gauss-newton and OuterGradient/lean_reach/bilevel/active-set: the
+// bilevel multi-contact scenarios' first stage (closed chains: the closing joints' map in
+// every sample) at their initial motion.
 // Threads: OMP_NUM_THREADS.
 #include <benchmark/benchmark.h>
 
@@ -26,8 +29,7 @@ Scenario kick(HessianOption hessian) {
   return scenario;
 }
 
-void outerHessian(benchmark::State& state, HessianOption option) {
-  const Scenario scenario = kick(option);
+void outerHessian(benchmark::State& state, const Scenario& scenario) {
   MotionProblem problem(scenario);
   const Eigen::VectorXd x = problem.initialPoint(scenario.start, scenario.end);
   const Eigen::VectorXd multipliers = Eigen::VectorXd::Ones(problem.constraintCount());
@@ -74,7 +76,19 @@ void registerOuterHessianBenchmarks() {
         ->Unit(benchmark::kMillisecond);
   for (const HessianOption option : {HessianOption::FiniteDifferences, HessianOption::SampleDifferences,
                                      HessianOption::GaussNewton, HessianOption::Exact})
-    benchmark::RegisterBenchmark((std::string("OuterHessian/Kick100/hrp2/") + toString(option)).c_str(), outerHessian, option)
+    benchmark::RegisterBenchmark((std::string("OuterHessian/Kick100/hrp2/") + toString(option)).c_str(), outerHessian,
+                                 kick(option))
+        ->Unit(benchmark::kMillisecond);
+  const auto bundled = [](const std::string& file) {
+    Scenario scenario = loadScenario(std::filesystem::path(MCOPT_SOURCE_DIR) / "scenarios" / file);
+    scenario.solve.hessian = HessianOption::GaussNewton;
+    return scenario;
+  };
+  benchmark::RegisterBenchmark("OuterGradient/lean_reach/bilevel/active-set", outerGradient, bundled("hrp2_lean_reach.yaml"))
+      ->Unit(benchmark::kMillisecond);
+  for (const std::string name : {"weight_shift", "lean_reach"})
+    benchmark::RegisterBenchmark(("OuterHessian/" + name + "/gauss-newton").c_str(), outerHessian,
+                                 bundled("hrp2_" + name + ".yaml"))
         ->Unit(benchmark::kMillisecond);
 }
 
