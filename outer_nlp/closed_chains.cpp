@@ -226,13 +226,13 @@ std::pair<double, double> ClosedChains::poseError(const DynamicsModel& model, Cl
 
 bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q,
                          Eigen::Ref<Eigen::VectorXd> v, Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map,
-                         ClosureSet set) const {
+                         ClosureSet set, ClosureOrder order) const {
   set &= all();
   if (set == 0) {
     if (map) map->setZero();
     return true;
   }
-  const int c = closingCount(), n = model.jointCount();
+  const int c = closingCount();
   auto closed = [&](int k) { return ((set >> contactOf_[static_cast<std::size_t>(closing_[static_cast<std::size_t>(k)])]) & 1U) != 0; };
   // The closing joints' point-form Jacobian columns at the pose in d.data: (linear velocity of
   // the frame origin, angular velocity), world axes — e's derivative at e = 0.
@@ -292,6 +292,12 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     if (map) map->setConstant(std::numeric_limits<double>::quiet_NaN());
     return false;
   }
+  // The map reads the velocity Jacobian at the closed pose (q alone: the same whatever q̇ and
+  // q̈ are), its q̇ rows the twist's q derivative (q and q̇ alone).
+  if (order == ClosureOrder::Positions) {
+    if (map) writeMap(model, d, q, v, a, *map, set, order);
+    return true;
+  }
   // Velocities: J (q̇ with q̇_C = 0) + J_C q̇_C = 0.
   closingJacobian(true);
   for (int k = 0; k < c; ++k)
@@ -302,6 +308,10 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   d.step.noalias() = d.lu.solve(d.residual);
   for (int k = 0; k < c; ++k)
     if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
+  if (order == ClosureOrder::Velocities) {
+    if (map) writeMap(model, d, q, v, a, *map, set, order);
+    return true;
+  }
   // Accelerations: the spatial acceleration with q̈_C = 0, against the fixed world's (the
   // reference body's, gravity folded in), then S_C q̈_C cancels the difference. S is the frame
   // Jacobian about the world origin.
@@ -321,8 +331,15 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   d.step.noalias() = d.lu.solve(d.residual);
   for (int k = 0; k < c; ++k)
     if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
-  if (!map) return true;
+  if (map) writeMap(model, d, q, v, a, *map, set, order);
+  return true;
+}
 
+void ClosedChains::writeMap(const DynamicsModel& model, ClosedChainData& d, const Eigen::Ref<const Eigen::VectorXd>& q,
+                            const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& a,
+                            Eigen::MatrixXd& M, ClosureSet set, ClosureOrder order) const {
+  const int c = closingCount(), n = model.jointCount();
+  auto closed = [&](int k) { return ((set >> contactOf_[static_cast<std::size_t>(closing_[static_cast<std::size_t>(k)])]) & 1U) != 0; };
   // ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) by the implicit function theorem, at the closed state.
   inverseDynamics(model, d.data, q, v, a);
   for (int i = 0; i < contactCount(); ++i) {
@@ -336,7 +353,6 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
   keepOpen(d, set);
   d.lu.compute(d.closing);
-  Eigen::MatrixXd& M = *map;
   auto Mq = M.topRows(c), Mv = M.middleRows(c, c), Ma = M.bottomRows(c);
   // Right-hand sides in the other joints' columns (the closed joints' zeroed), then the
   // closed joints' own terms through the rows already solved; an open contact's rows zero
@@ -349,23 +365,34 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     for (int i = 0; i < contactCount(); ++i)
       if (!((set >> i) & 1U)) d.rhs.middleRows<6>(6 * i).setZero();
   };
-  d.rhs.setZero();
+  // M is block lower triangular: M_q reads q alone, M_v q and q̇. Each block is solved for its
+  // own columns only (the solve is column by column: the same values as over all 3n) and the
+  // columns right of them are zero.
   d.rhs.leftCols(n) = d.spatial;
   withoutClosing(d.rhs.leftCols(n));
   openRowsZero();
-  Mq = d.lu.solve(d.rhs);
-  Mq *= -1.0;
+  Mq.leftCols(n) = d.lu.solve(d.rhs.leftCols(n));
+  Mq.leftCols(n) *= -1.0;
+  Mq.rightCols(2 * n).setZero();
+  if (order == ClosureOrder::Positions) {
+    Mv.setZero(), Ma.setZero();
+    return;
+  }
 
   d.rhs.leftCols(n) = d.twistByAngle;
   d.rhs.middleCols(n, n) = d.spatial;
-  d.rhs.rightCols(n).setZero();
   withoutClosing(d.rhs.leftCols(n));
   withoutClosing(d.rhs.middleCols(n, n));
   for (int k = 0; k < c; ++k)
-    if (closed(k)) d.rhs.noalias() += d.twistByAngle.col(closing_[static_cast<std::size_t>(k)]) * Mq.row(k);
+    if (closed(k)) d.rhs.leftCols(n).noalias() += d.twistByAngle.col(closing_[static_cast<std::size_t>(k)]) * Mq.row(k).head(n);
   openRowsZero();
-  Mv = d.lu.solve(d.rhs);
-  Mv *= -1.0;
+  Mv.leftCols(2 * n) = d.lu.solve(d.rhs.leftCols(2 * n));
+  Mv.leftCols(2 * n) *= -1.0;
+  Mv.rightCols(n).setZero();
+  if (order == ClosureOrder::Velocities) {
+    Ma.setZero();
+    return;
+  }
 
   d.rhs.leftCols(n) = d.accelerationByAngle;
   d.rhs.middleCols(n, n) = d.accelerationByVelocity;
@@ -376,13 +403,12 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
   for (int k = 0; k < c; ++k) {
     if (!closed(k)) continue;
     const int j = closing_[static_cast<std::size_t>(k)];
-    d.rhs.noalias() += d.accelerationByAngle.col(j) * Mq.row(k);
-    d.rhs.noalias() += d.accelerationByVelocity.col(j) * Mv.row(k);
+    d.rhs.leftCols(n).noalias() += d.accelerationByAngle.col(j) * Mq.row(k).head(n);
+    d.rhs.leftCols(2 * n).noalias() += d.accelerationByVelocity.col(j) * Mv.row(k).head(2 * n);
   }
   openRowsZero();
   Ma = d.lu.solve(d.rhs);
   Ma *= -1.0;
-  return true;
 }
 
 }  // namespace mcopt

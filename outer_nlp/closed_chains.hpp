@@ -67,6 +67,11 @@ struct LoopReach {
 /// Which contacts are closed at an instant: bit i for contact i.
 using ClosureSet = std::uint32_t;
 
+/// How much of the state ClosedChains::close closes: the pose alone, the pose and the
+/// velocities, or all three. A task reads q and q̇ alone (a position task q alone), and its
+/// closing joints' q and q̇ (and their map's rows) do not depend on what q̈ is.
+enum class ClosureOrder { Positions, Velocities, Accelerations };
+
 /// Per-thread buffers of ClosedChains::close, sized once (no allocation afterwards).
 struct ClosedChainData {
   ClosedChainData(const DynamicsModel& model, int contacts);
@@ -125,8 +130,11 @@ class ClosedChains {
   /// ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈), zero in the closed joints' columns and in the rows of the
   /// joints of contacts outside `set`. Returns false, with the closed entries NaN, when Newton's
   /// method does not reach the pose (a loop that cannot close: a step too far for Ipopt).
+  /// Below ClosureOrder::Accelerations, the entries past `order` (q̈, or q̇ and q̈) stay as given
+  /// and the map's rows for them are zero; the others are what the whole closure gives, to the bit.
   bool close(const DynamicsModel& model, ClosedChainData& d, Eigen::Ref<Eigen::VectorXd> q, Eigen::Ref<Eigen::VectorXd> v,
-             Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map, ClosureSet set) const;
+             Eigen::Ref<Eigen::VectorXd> a, Eigen::MatrixXd* map, ClosureSet set,
+             ClosureOrder order = ClosureOrder::Accelerations) const;
 
   /// Contact i's loop: its two joint origins and its longest reach (LoopReach).
   const LoopReach& reach(int contact) const { return reaches_[static_cast<std::size_t>(contact)]; }
@@ -152,6 +160,10 @@ class ClosedChains {
   /// In d.closing and d.residual: a contact outside `set` keeps its closing joints, its rows
   /// the identity on their columns with a zero right-hand side (their step is zero).
   void keepOpen(ClosedChainData& d, ClosureSet set) const;
+  /// close's `map` at the closed state (q, v, a), its rows up to `order`, the others zero.
+  void writeMap(const DynamicsModel& model, ClosedChainData& d, const Eigen::Ref<const Eigen::VectorXd>& q,
+                const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& a, Eigen::MatrixXd& map,
+                ClosureSet set, ClosureOrder order) const;
   std::vector<HeldContact> contacts_;
   Eigen::VectorXd posture_;  ///< the start posture: Newton's second start
   std::vector<int> closing_, contactOf_;

@@ -19,11 +19,11 @@
 
 namespace mcopt {
 
-bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const {
+bool MotionProblem::closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map, ClosureOrder order) const {
   if (!closure_) return true;
   // Newton from the angles reached last at this instant: the same closure, in one or two steps.
   if (!b.startFromSplines) closure_->placeAngles(b.closedAngles, b.closed, w.q);
-  return closure_->close(model_, w.closure, w.q, w.v, w.a, map, b.closed);
+  return closure_->close(model_, w.closure, w.q, w.v, w.a, map, b.closed, order);
 }
 
 void MotionProblem::startClosureAlongTheMotion(const Eigen::MatrixXd& controlPoints, double T) {
@@ -78,8 +78,8 @@ void MotionProblem::startTaskClosures() {
   }
 }
 
-void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives) {
-  if (!closure_ || !closeState(b, w, derivatives ? &b.closureMap : nullptr)) return;
+void MotionProblem::closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives, ClosureOrder order) {
+  if (!closure_ || !closeState(b, w, derivatives ? &b.closureMap : nullptr, order)) return;
   closure_->readAngles(w.q, b.closed, b.closedAngles);
 }
 

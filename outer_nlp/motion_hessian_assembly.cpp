@@ -194,7 +194,102 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       out.columns.push_back(parameterCount_);
     };
 
-#pragma omp for schedule(static)
+    // The task instants first, each a thread's (their differences, with closed chains a closure
+    // a probe, cost as much as several samples), the samples shared as threads come free: every
+    // slot is computed alike on any thread, so the sum below is the same whatever the schedule.
+#pragma omp for schedule(dynamic) nowait
+    for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
+      const TaskSpec& spec = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
+      const Task& task = *spec.task;
+      const auto lambda = taskMultipliers_.col(i).head(spec.dimension());
+      LocalHessian& slot = localHessians_[blocks_.size() + static_cast<std::size_t>(i)];
+      slot.size = 0;
+      if ((lambda.array() == 0.0).all()) continue;  // no bounded component
+      const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
+      // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
+      const bool velocity = task.readsVelocity();
+      const int d = velocity ? 2 * n : n;
+      auto base = h.base.head(d), gradient = h.gradient.head(d);
+      base.head(n).noalias() = b.dyDq.transpose() * lambda;
+      if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
+      taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
+      closeState(b, w, nullptr);
+      const int taskBlocks = velocity ? 2 : 1;
+      if (closure_ && !exact) {  // as the samples': differences in the spline joints' state
+        foldGradient(b.closureMap, b.closed, taskBlocks, base);
+        h.closedState << w.q, w.v, w.a;
+      }
+      const bool durationTerms = exact && freeDuration && velocity;
+      // A throw's rows are functions of the ball's state k = (p, v_p): their exact Hessian is the
+      // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (ball_flight_task.hpp).
+      const BallFlightTask* flight = exact ? task.ballFlight() : nullptr;
+      if (flight) {
+        inverseDynamics(model_, w.data, w.q, w.v, w.a);
+        flight->flightCurvature(model_, w.data, lambda, w.task, h.ballWeights, h.stateHessian.topLeftCorner(d, d));
+      }
+      if (durationTerms) {  // u = ∂z/∂T = (0, −q̇/T) at the instant, before the probes move q̇
+        h.stateByDuration.head(n).setZero();
+        h.stateByDuration.segment(n, n) = -w.v / T;
+      }
+      for (int c = 0; c < d; ++c) {
+        double& component = c < n ? w.q[c] : w.v[c - n];
+        const double saved = component;
+        if (exact) {
+          // The task's gradient with its multipliers is trigonometric in an angle and linear in q̇.
+          const DerivativeStencil& stencil = c < n ? exactStencils_.taskAngle : exactStencils_.taskVelocity;
+          auto column = h.column.head(d);
+          column.setZero();
+          for (int m = 0; m < stencil.size(); ++m) {
+            component = saved + stencil.offsets[static_cast<std::size_t>(m)];
+            if (flight) {
+              inverseDynamics(model_, w.data, w.q, w.v, w.a);
+              flight->ballStateGradient(model_, w.data, h.ballWeights, w.task, gradient.head(n), gradient.tail(n));
+            } else {
+              taskOutputs(i, true, w, taskProbe);
+              gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
+              if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
+            }
+            column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
+          }
+          component = saved;
+          if (flight)
+            h.stateHessian.col(c).head(d) += column;
+          else
+            h.stateHessian.col(c).head(d) = column;
+          continue;
+        }
+        if (closure_ && closure_->closesIn(c % n, b.closed)) {
+          h.stateHessian.col(c).head(d).setZero();
+          continue;
+        }
+        const double step = differenceStep(saved);
+        component = saved + step;
+        // A probe closes what the task reads: q, and q̇ when it reads velocities.
+        if (closure_)
+          closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed,
+                          velocity ? ClosureOrder::Velocities : ClosureOrder::Positions);
+        taskOutputs(i, true, w, taskProbe);
+        component = saved;
+        if (closure_) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
+        gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
+        if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
+        if (closure_) foldGradient(h.probeMap, b.closed, taskBlocks, gradient);
+        h.stateHessian.col(c).head(d) = (gradient - base) / step;
+      }
+      symmetrise(d);
+      if (durationTerms) {
+        // z = (q, q̇ = B1 x / T): u = (0, −q̇/T), ĝ = (0, −g_q̇/T), z'' = (0, 2q̇/T²) = −2u/T.
+        const auto H = h.stateHessian.topLeftCorner(d, d);
+        const auto u = h.stateByDuration.head(d);
+        auto dz = h.durationRow.head(d);
+        dz.noalias() = H * u;
+        h.durationCurvature = u.dot(dz) - 2.0 / T * base.tail(n).dot(u.tail(n));
+        dz.tail(n) -= base.tail(n) / T;
+      }
+      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms, nullptr, 0);
+    }
+
+#pragma omp for schedule(dynamic)
     for (int s = 0; s < N; ++s) {
       const SampleBlock& b = blocks_[static_cast<std::size_t>(s)];
       const int nf = static_cast<int>(b.forceColumns.size()), d = 3 * n + nf;
@@ -263,95 +358,6 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       if (formulation_->keepsSampleState()) sampleOutputs(s, h.probeX, false, w, probe);
       symmetrise(d);
       spread(samples_.weights(s), b.parameters, 3, b.forceColumns, localHessians_[static_cast<std::size_t>(s)], false, nullptr, 0);
-    }
-
-#pragma omp for schedule(static)
-    for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
-      const TaskSpec& spec = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
-      const Task& task = *spec.task;
-      const auto lambda = taskMultipliers_.col(i).head(spec.dimension());
-      LocalHessian& slot = localHessians_[blocks_.size() + static_cast<std::size_t>(i)];
-      slot.size = 0;
-      if ((lambda.array() == 0.0).all()) continue;  // no bounded component
-      const SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
-      // Positions, orientations and the centre of mass read q alone; velocities q and q̇.
-      const bool velocity = task.readsVelocity();
-      const int d = velocity ? 2 * n : n;
-      auto base = h.base.head(d), gradient = h.gradient.head(d);
-      base.head(n).noalias() = b.dyDq.transpose() * lambda;
-      if (velocity) base.tail(n).noalias() = b.dyDv.transpose() * lambda;
-      taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
-      closeState(b, w, nullptr);
-      const int taskBlocks = velocity ? 2 : 1;
-      if (closure_ && !exact) {  // as the samples': differences in the spline joints' state
-        foldGradient(b.closureMap, b.closed, taskBlocks, base);
-        h.closedState << w.q, w.v, w.a;
-      }
-      const bool durationTerms = exact && freeDuration && velocity;
-      // A throw's rows are functions of the ball's state k = (p, v_p): their exact Hessian is the
-      // flight's curvature through ∂k/∂z plus the stencil of wᵀ ∇k, w held (ball_flight_task.hpp).
-      const BallFlightTask* flight = exact ? task.ballFlight() : nullptr;
-      if (flight) {
-        inverseDynamics(model_, w.data, w.q, w.v, w.a);
-        flight->flightCurvature(model_, w.data, lambda, w.task, h.ballWeights, h.stateHessian.topLeftCorner(d, d));
-      }
-      if (durationTerms) {  // u = ∂z/∂T = (0, −q̇/T) at the instant, before the probes move q̇
-        h.stateByDuration.head(n).setZero();
-        h.stateByDuration.segment(n, n) = -w.v / T;
-      }
-      for (int c = 0; c < d; ++c) {
-        double& component = c < n ? w.q[c] : w.v[c - n];
-        const double saved = component;
-        if (exact) {
-          // The task's gradient with its multipliers is trigonometric in an angle and linear in q̇.
-          const DerivativeStencil& stencil = c < n ? exactStencils_.taskAngle : exactStencils_.taskVelocity;
-          auto column = h.column.head(d);
-          column.setZero();
-          for (int m = 0; m < stencil.size(); ++m) {
-            component = saved + stencil.offsets[static_cast<std::size_t>(m)];
-            if (flight) {
-              inverseDynamics(model_, w.data, w.q, w.v, w.a);
-              flight->ballStateGradient(model_, w.data, h.ballWeights, w.task, gradient.head(n), gradient.tail(n));
-            } else {
-              taskOutputs(i, true, w, taskProbe);
-              gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
-              if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
-            }
-            column += stencil.weights[static_cast<std::size_t>(m)] * gradient;
-          }
-          component = saved;
-          if (flight)
-            h.stateHessian.col(c).head(d) += column;
-          else
-            h.stateHessian.col(c).head(d) = column;
-          continue;
-        }
-        if (closure_ && closure_->closesIn(c % n, b.closed)) {
-          h.stateHessian.col(c).head(d).setZero();
-          continue;
-        }
-        const double step = differenceStep(saved);
-        component = saved + step;
-        if (closure_) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed);
-        taskOutputs(i, true, w, taskProbe);
-        component = saved;
-        if (closure_) w.q = h.closedState.head(n), w.v = h.closedState.segment(n, n), w.a = h.closedState.tail(n);
-        gradient.head(n).noalias() = taskProbe.dyDq.topRows(lambda.size()).transpose() * lambda;
-        if (velocity) gradient.tail(n).noalias() = taskProbe.dyDv.topRows(lambda.size()).transpose() * lambda;
-        if (closure_) foldGradient(h.probeMap, b.closed, taskBlocks, gradient);
-        h.stateHessian.col(c).head(d) = (gradient - base) / step;
-      }
-      symmetrise(d);
-      if (durationTerms) {
-        // z = (q, q̇ = B1 x / T): u = (0, −q̇/T), ĝ = (0, −g_q̇/T), z'' = (0, 2q̇/T²) = −2u/T.
-        const auto H = h.stateHessian.topLeftCorner(d, d);
-        const auto u = h.stateByDuration.head(d);
-        auto dz = h.durationRow.head(d);
-        dz.noalias() = H * u;
-        h.durationCurvature = u.dot(dz) - 2.0 / T * base.tail(n).dot(u.tail(n));
-        dz.tail(n) -= base.tail(n) / T;
-      }
-      spread(taskSamples_.weights(i), b.parameters, velocity ? 2 : 1, {}, slot, durationTerms, nullptr, 0);
     }
   }
 

@@ -373,8 +373,10 @@ class MotionProblem final : public NlpProblem {
   void taskOutputs(int i, bool derivatives, ThreadWorkspace& w, SampleBlock& b);
   void buildStructure();
   /// The closing joints' state in w.q, w.v, w.a from the others' (Newton from b's last angles),
-  /// with the map into `map` when given. False when the loop cannot close there.
-  bool closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map) const;
+  /// with the map into `map` when given, up to `order` (ClosedChains::close). False when the
+  /// loop cannot close there.
+  bool closeState(const SampleBlock& b, ThreadWorkspace& w, Eigen::MatrixXd* map,
+                  ClosureOrder order = ClosureOrder::Accelerations) const;
   /// Without angles to start from (a new problem, not started from another's: startClosureAt),
   /// the closure at every sample in time order, Newton from the sample before's angles (from the
   /// splines' where a window starts), and at each task instant from the nearest sample's: the
@@ -388,7 +390,8 @@ class MotionProblem final : public NlpProblem {
   void checkLoopReaches() const;
   /// The same at an evaluation's own state: the map into b (with derivatives) and the angles
   /// reached kept in b for the next Newton start.
-  void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives);
+  void closeAndRemember(SampleBlock& b, ThreadWorkspace& w, bool derivatives,
+                        ClosureOrder order = ClosureOrder::Accelerations);
   /// Chain rule through the closure: (dyDq, dyDv, dyDa) of b, the closing joints' columns
   /// folded into the others' through b.closureMap, into dq, dv, da.
   /// (All four of b's output rows: a task instant passes its workspace's top rows.)

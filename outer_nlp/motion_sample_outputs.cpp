@@ -97,11 +97,12 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
 void MotionProblem::evaluateTaskInstant(int i, double T, bool derivatives, ThreadWorkspace& w) {
   SampleBlock& b = taskBlocks_[static_cast<std::size_t>(i)];
   taskSamples_.evaluate(i, controlPoints_, T, w.q, w.v, w.a);
-  closeAndRemember(b, w, derivatives);
+  // Tasks read q and q̇ (the dynamics' forward pass takes the splines' q̈, which no task reads).
+  closeAndRemember(b, w, derivatives, ClosureOrder::Velocities);
   taskOutputs(i, derivatives, w, b);
   if (!derivatives) return;
   if (closure_) {
-    // Tasks read q and q̇; the closure's q_C and q̇_C depend on no q̈.
+    // The closure's q_C and q̇_C depend on no q̈ (the map's q̈ rows are zero).
     const Eigen::Index d = b.y.size();
     foldClosure(b, w.taskGather.topRows(d), w.taskFoldQ.topRows(d), w.taskFoldV.topRows(d), w.taskFoldA.topRows(d));
     taskSamples_.chainRule(i, T, w.taskFoldQ.topRows(d), w.taskFoldV.topRows(d), Eigen::MatrixXd(), b.dyDx, b.parameters);

@@ -189,6 +189,49 @@ TEST_CASE("closed chains: a contact left open keeps its joints, and the map of t
   }
 }
 
+TEST_CASE("closed chains: closing to positions or velocities gives the whole closure's values to the bit, the rest left",
+          "[outer][closure]") {
+  // The lean reach's sole and hand, both closed and the hand open: what a task's closure reads
+  // (q, and q̇ for a velocity task) and its map's rows are the whole closure's, bit for bit; the
+  // entries past the order keep their values and the map's rows past it are zero.
+  const Scenario s = leanReach();
+  const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
+  std::vector<HeldContact> held;
+  for (const EnvironmentContact& c : s.contacts)
+    held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose, {0.0, 1.0}});
+  const ClosedChains chains(model, held, s.start);
+  const int n = model.jointCount(), c = chains.closingCount();
+  ClosedChainData d(model, 2);
+  std::mt19937 random(11);
+  const Eigen::VectorXd q0 = s.start + test::randomVector(random, n, 0.05), v0 = test::randomVector(random, n, 0.5),
+                        a0 = test::randomVector(random, n, 2.0);
+  for (const ClosureSet set : {ClosureSet{1}, ClosureSet{3}}) {
+    Eigen::VectorXd q = q0, v = v0, a = a0;
+    Eigen::MatrixXd whole(3 * c, 3 * n);
+    REQUIRE(chains.close(model, d, q, v, a, &whole, set));
+    CHECK(whole.topRows(c).rightCols(2 * n).norm() == 0.0);  // M_q reads q alone, M_v q and q̇
+    CHECK(whole.middleRows(c, c).rightCols(n).norm() == 0.0);
+    for (const ClosureOrder order : {ClosureOrder::Positions, ClosureOrder::Velocities}) {
+      const int rows = order == ClosureOrder::Positions ? 1 : 2;
+      INFO("set " << set << ", closing " << (rows == 1 ? "positions" : "velocities"));
+      Eigen::VectorXd qo = q0, vo = v0, ao = a0;
+      Eigen::MatrixXd map = Eigen::MatrixXd::Constant(3 * c, 3 * n, 7.0);
+      REQUIRE(chains.close(model, d, qo, vo, ao, &map, set, order));
+      CHECK(qo == q);
+      CHECK(ao == a0);
+      if (rows == 2) CHECK(vo == v);
+      else CHECK(vo == v0);
+      CHECK(map.topRows(rows * c) == whole.topRows(rows * c));
+      CHECK(map.bottomRows((3 - rows) * c).norm() == 0.0);
+      Eigen::VectorXd qn = q0, vn = v0, an = a0;  // and without a map
+      REQUIRE(chains.close(model, d, qn, vn, an, nullptr, set, order));
+      CHECK(qn == q);
+      CHECK(vn == vo);
+      CHECK(an == a0);
+    }
+  }
+}
+
 TEST_CASE("closed chains: a window's contact holds inside it, and the splines meet it at rest at its ends",
           "[outer][closure]") {
   // The lean reach's hand on the table over [1.0, 2.2] s: its arm's six joints follow the
