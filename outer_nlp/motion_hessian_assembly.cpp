@@ -170,12 +170,18 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
         for (int l = 0; l < k; ++l)
           for (int block = 0; block < stateBlocks; ++block) HB.col(j * k + l) += weight(block, l) * H.col(block * n + j);
       for (int f = 0; f < nf; ++f) HB.col(n * k + f) = H.col(stateBlocks * n + f);
-      auto BHB = out.values.topLeftCorner(local, local);  // Bᵀ H B
-      BHB.setZero();
-      for (int j = 0; j < n; ++j)
-        for (int l = 0; l < k; ++l)
-          for (int block = 0; block < stateBlocks; ++block) BHB.row(j * k + l) += weight(block, l) * HB.row(block * n + j);
-      for (int f = 0; f < nf; ++f) BHB.row(n * k + f) = HB.row(stateBlocks * n + f);
+      auto BHB = out.values.topLeftCorner(local, local);  // Bᵀ H B, column by column (contiguous)
+      for (int c = 0; c < local; ++c) {
+        const auto from = HB.col(c);
+        auto to = BHB.col(c);
+        for (int j = 0; j < n; ++j)
+          for (int l = 0; l < k; ++l) {
+            double sum = 0.0;
+            for (int block = 0; block < stateBlocks; ++block) sum += weight(block, l) * from[block * n + j];
+            to[j * k + l] = sum;
+          }
+        for (int f = 0; f < nf; ++f) to[n * k + f] = from[stateBlocks * n + f];
+      }
       out.size = local;
       out.columns.resize(static_cast<std::size_t>(local));
       for (int c = 0; c < n * k; ++c) out.columns[static_cast<std::size_t>(c)] = parameters[c];
@@ -363,12 +369,21 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
 
   // Summed in sample order, whatever thread computed each term: the same Hessian, to the
   // bit, for any thread count (docs/developers/determinism.md, "Determinism").
+  // Each thread sums a range of the columns, every entry still in slot order.
   Eigen::MatrixXd& hessian = hessianSum_;
   hessian.setZero(curved, curved);
-  for (const LocalHessian& l : localHessians_)
-    for (int r = 0; r < l.size; ++r)
-      for (int c = 0; c < l.size; ++c)
-        hessian(l.columns[static_cast<std::size_t>(r)], l.columns[static_cast<std::size_t>(c)]) += l.values(r, c);
+#pragma omp parallel num_threads(threads)
+  {
+    const int t = omp_get_thread_num(), parts = omp_get_num_threads();
+    const int first = static_cast<int>(static_cast<long>(curved) * t / parts);
+    const int last = static_cast<int>(static_cast<long>(curved) * (t + 1) / parts);
+    for (const LocalHessian& l : localHessians_)
+      for (int c = 0; c < l.size; ++c) {
+        const int column = l.columns[static_cast<std::size_t>(c)];
+        if (column < first || column >= last) continue;
+        for (int r = 0; r < l.size; ++r) hessian(l.columns[static_cast<std::size_t>(r)], column) += l.values(r, c);
+      }
+  }
 
   if (durationIsFree() && hessian_ == HessianOption::Exact) {
     // The samples and task instants brought theirs; the control-point rows (the velocity

@@ -485,8 +485,12 @@ void MotionProblem::jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& va
   const double T = duration(x);
   values.resize(jacobianNonZeros());
   using Source = JacobianEntry::Source;
-  for (std::size_t k = 0; k < entries_.size(); ++k) {
-    const JacobianEntry& e = entries_[k];
+  // A gather of every entry from the blocks (over a hundred thousand, most from blocks no
+  // longer in cache): each value on its own, so the threads share them.
+  const auto count = static_cast<std::ptrdiff_t>(entries_.size());
+#pragma omp parallel for schedule(static) num_threads(static_cast<int>(workspaces_.size()))
+  for (std::ptrdiff_t k = 0; k < count; ++k) {
+    const JacobianEntry& e = entries_[static_cast<std::size_t>(k)];
     const auto block = static_cast<std::size_t>(e.block);
     const SampleBlock* b = e.block < 0 ? nullptr : e.task ? &taskBlocks_[block] : &blocks_[block];
     double value = 0.0;
@@ -496,12 +500,12 @@ void MotionProblem::jacobianValues(const Eigen::VectorXd& x, Eigen::VectorXd& va
       case Source::Force: value = b->dyDz(e.output, e.local); break;
       case Source::Slack: value = 1.0; break;
       case Source::Direct: {
-        const Row& row = rows_[static_cast<std::size_t>(jacobianRows_[static_cast<Eigen::Index>(k)])];
+        const Row& row = rows_[static_cast<std::size_t>(jacobianRows_[k])];
         value = terms_[static_cast<std::size_t>(row.term)]->directDerivative(row.detail, e.local, x, T);
         break;
       }
     }
-    values[static_cast<Eigen::Index>(k)] = e.sign * value;
+    values[k] = e.sign * value;
   }
 }
 
