@@ -51,6 +51,9 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
                            b.y, b.wrenches, b.dyDq, b.dyDv, b.dyDa, b.dyDz};
   formulation_->sampleOutputs(sample);
 
+  // P_j = P(Γ_j, q̇_j, q̈_j): its rows are ∂P/∂Γ times Γ_j's, plus its own q̇_j and q̈_j
+  // entries. The torque and power rows are two blocks of n rows (sample_outputs.hpp): the
+  // products are taken block by block (contiguous columns, not rows n apart).
   for (int j = 0; j < n; ++j) {
     const MotorPowerDerivatives p = motorPowerDerivatives(scenario_.actuators.joints[static_cast<std::size_t>(j)],
                                                           scenario_.actuators.frictionSharpness, w.torque[j], w.v[j],
@@ -58,13 +61,17 @@ void MotionProblem::sampleOutputs(int s, const Eigen::VectorXd& x, bool derivati
     b.y[outputs_.torque(j)] = w.torque[j];
     b.y[outputs_.power(j)] = p.power;
     if (!derivatives) continue;
-    const int row = outputs_.power(j);
-    b.dyDq.row(row) = p.dTorque * b.dyDq.row(outputs_.torque(j));
-    b.dyDv.row(row) = p.dTorque * b.dyDv.row(outputs_.torque(j));
-    b.dyDa.row(row) = p.dTorque * b.dyDa.row(outputs_.torque(j));
-    b.dyDv(row, j) += p.dVelocity;
-    b.dyDa(row, j) += p.dAcceleration;
-    if (b.dyDz.cols() > 0) b.dyDz.row(row) = p.dTorque * b.dyDz.row(outputs_.torque(j));
+    w.powerByTorque[j] = p.dTorque, w.powerByVelocity[j] = p.dVelocity, w.powerByAcceleration[j] = p.dAcceleration;
+  }
+  if (derivatives) {
+    const int torques = outputs_.torque(0), powers = outputs_.power(0);
+    const auto scale = w.powerByTorque.asDiagonal();
+    b.dyDq.middleRows(powers, n).noalias() = scale * b.dyDq.middleRows(torques, n);
+    b.dyDv.middleRows(powers, n).noalias() = scale * b.dyDv.middleRows(torques, n);
+    b.dyDa.middleRows(powers, n).noalias() = scale * b.dyDa.middleRows(torques, n);
+    b.dyDv.middleRows(powers, n).diagonal() += w.powerByVelocity;
+    b.dyDa.middleRows(powers, n).diagonal() += w.powerByAcceleration;
+    if (b.dyDz.cols() > 0) b.dyDz.middleRows(powers, n).noalias() = scale * b.dyDz.middleRows(torques, n);
   }
   // The closing joints' angles and velocities, for their limits (their derivatives in the
   // full state: unit rows, folded through the closure by the caller).

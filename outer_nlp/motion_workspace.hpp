@@ -27,6 +27,7 @@ struct MotionWorkspace {
       : data(model), derivatives(model), task(model), closure(model, held) {
     const int n = model.jointCount();
     q.setZero(n), v.setZero(n), a.setZero(n), torque.setZero(n);
+    powerByTorque.setZero(n), powerByVelocity.setZero(n), powerByAcceleration.setZero(n);
     torqueDq.setZero(n, n), referenceDq.setZero(6, n), dWorld.setZero(6, n), dTorque.setZero(n, n);
     const std::size_t contacts = contactRows.size() - 1;
     toTorque.assign(contacts, WrenchToTorque::Zero(n, 6));
@@ -41,6 +42,7 @@ struct MotionWorkspace {
   DynamicsDerivatives derivatives;
   TaskWorkspace task;
   Eigen::VectorXd q, v, a, torque;
+  Eigen::VectorXd powerByTorque, powerByVelocity, powerByAcceleration;  ///< ∂P_j/∂(Γ_j, q̇_j, q̈_j) at the sample
   Eigen::MatrixXd torqueDq, dTorque;
   Eigen::Matrix<double, 6, Eigen::Dynamic> referenceDq, dWorld;
   std::vector<WrenchToTorque> toTorque;  ///< per environment contact, J1_i
