@@ -57,6 +57,22 @@ Scenario leanReach() {
   return s;
 }
 
+/// The lean reach's environment contacts (the right sole, the hand), held over the whole motion.
+std::vector<HeldContact> leanReachContacts(const Scenario& s) {
+  std::vector<HeldContact> held;
+  for (const EnvironmentContact& c : s.contacts)
+    held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose, {0.0, 1.0}});
+  REQUIRE(held.size() == 2);
+  return held;
+}
+
+/// A state near the start posture: q within 0.05 rad of it, velocities and accelerations of
+/// about 0.5 rad/s and 2 rad/s².
+void stateNearStart(std::mt19937& random, const Scenario& s, Eigen::VectorXd& q, Eigen::VectorXd& v, Eigen::VectorXd& a) {
+  const auto n = static_cast<int>(s.start.size());
+  q = s.start + test::randomVector(random, n, 0.05), v = test::randomVector(random, n, 0.5), a = test::randomVector(random, n, 2.0);
+}
+
 }  // namespace
 
 TEST_CASE("closed chains: the closure's map is its derivative (central differences)", "[outer][closure]") {
@@ -68,8 +84,8 @@ TEST_CASE("closed chains: the closure's map is its derivative (central differenc
   const int n = model.jointCount(), c = chains.closingCount();
   ClosedChainData d(model, 1);
   std::mt19937 random(3);
-  Eigen::VectorXd q = s.start + test::randomVector(random, n, 0.05), v = test::randomVector(random, n, 0.5),
-                  a = test::randomVector(random, n, 2.0);
+  Eigen::VectorXd q, v, a;
+  stateNearStart(random, s, q, v, a);
   Eigen::MatrixXd map(3 * c, 3 * n);
   REQUIRE(chains.close(model, d, q, v, a, &map, chains.all()));
   // The contact holds: pose, twist and acceleration of the frame.
@@ -132,10 +148,7 @@ TEST_CASE("closed chains: a contact left open keeps its joints, and the map of t
   // given and are free columns of the sole's map; closed, the hand's joints follow it too.
   const Scenario s = leanReach();
   const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
-  std::vector<HeldContact> held;
-  for (const EnvironmentContact& c : s.contacts)
-    held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose, {0.0, 1.0}});
-  REQUIRE(held.size() == 2);
+  std::vector<HeldContact> held = leanReachContacts(s);
   held[1].window = {0.3, 0.6};
   const ClosedChains chains(model, held, s.start);
   CHECK(chains.closedAt(0.1, 0) == 1U);
@@ -146,8 +159,8 @@ TEST_CASE("closed chains: a contact left open keeps its joints, and the map of t
   REQUIRE(c == 12);
   ClosedChainData d(model, 2);
   std::mt19937 random(7);
-  const Eigen::VectorXd q0 = s.start + test::randomVector(random, n, 0.05), v0 = test::randomVector(random, n, 0.5),
-                        a0 = test::randomVector(random, n, 2.0);
+  Eigen::VectorXd q0, v0, a0;
+  stateNearStart(random, s, q0, v0, a0);
   for (const ClosureSet set : {ClosureSet{1}, ClosureSet{3}}) {
     Eigen::VectorXd q = q0, v = v0, a = a0;
     Eigen::MatrixXd map(3 * c, 3 * n);
@@ -196,15 +209,12 @@ TEST_CASE("closed chains: closing to positions or velocities gives the whole clo
   // entries past the order keep their values and the map's rows past it are zero.
   const Scenario s = leanReach();
   const DynamicsModel model(s.robot, s.referenceBody, s.referencePose, s.gravity);
-  std::vector<HeldContact> held;
-  for (const EnvironmentContact& c : s.contacts)
-    held.push_back({c.surface.name, c.surface.frame, c.surface.placement, c.worldPose, {0.0, 1.0}});
-  const ClosedChains chains(model, held, s.start);
+  const ClosedChains chains(model, leanReachContacts(s), s.start);
   const int n = model.jointCount(), c = chains.closingCount();
   ClosedChainData d(model, 2);
   std::mt19937 random(11);
-  const Eigen::VectorXd q0 = s.start + test::randomVector(random, n, 0.05), v0 = test::randomVector(random, n, 0.5),
-                        a0 = test::randomVector(random, n, 2.0);
+  Eigen::VectorXd q0, v0, a0;
+  stateNearStart(random, s, q0, v0, a0);
   for (const ClosureSet set : {ClosureSet{1}, ClosureSet{3}}) {
     Eigen::VectorXd q = q0, v = v0, a = a0;
     Eigen::MatrixXd whole(3 * c, 3 * n);
