@@ -233,7 +233,7 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     return true;
   }
   const int c = closingCount();
-  auto closed = [&](int k) { return ((set >> contactOf_[static_cast<std::size_t>(closing_[static_cast<std::size_t>(k)])]) & 1U) != 0; };
+  auto closed = [&](int k) { return closesIn(closing_[static_cast<std::size_t>(k)], set); };
   // The closing joints' point-form Jacobian columns at the pose in d.data: (linear velocity of
   // the frame origin, angular velocity), world axes — e's derivative at e = 0.
   auto closingJacobian = [&](bool full) {
@@ -292,45 +292,41 @@ bool ClosedChains::close(const DynamicsModel& model, ClosedChainData& d, Eigen::
     if (map) map->setConstant(std::numeric_limits<double>::quiet_NaN());
     return false;
   }
-  // The map reads the velocity Jacobian at the closed pose (q alone: the same whatever q̇ and
-  // q̈ are), its q̇ rows the twist's q derivative (q and q̇ alone).
-  if (order == ClosureOrder::Positions) {
-    if (map) writeMap(model, d, q, v, a, *map, set, order);
-    return true;
+  // Past `order`, the entries stay as given (the map reads the velocity Jacobian at the closed
+  // pose, q alone, and its q̇ rows the twist's q derivative, q and q̇ alone).
+  if (order != ClosureOrder::Positions) {
+    // Velocities: J (q̇ with q̇_C = 0) + J_C q̇_C = 0.
+    closingJacobian(true);
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = 0.0;
+    d.residual.noalias() = d.spatial * v;
+    keepOpen(d, set);
+    d.lu.compute(d.closing);
+    d.step.noalias() = d.lu.solve(d.residual);
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
   }
-  // Velocities: J (q̇ with q̇_C = 0) + J_C q̇_C = 0.
-  closingJacobian(true);
-  for (int k = 0; k < c; ++k)
-    if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = 0.0;
-  d.residual.noalias() = d.spatial * v;
-  keepOpen(d, set);
-  d.lu.compute(d.closing);
-  d.step.noalias() = d.lu.solve(d.residual);
-  for (int k = 0; k < c; ++k)
-    if (closed(k)) v[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
-  if (order == ClosureOrder::Velocities) {
-    if (map) writeMap(model, d, q, v, a, *map, set, order);
-    return true;
+  if (order == ClosureOrder::Accelerations) {
+    // Accelerations: the spatial acceleration with q̈_C = 0, against the fixed world's (the
+    // reference body's, gravity folded in), then S_C q̈_C cancels the difference. S is the frame
+    // Jacobian about the world origin.
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = 0.0;
+    inverseDynamics(model, d.data, q, v, a);
+    for (int i = 0; i < contactCount(); ++i) {
+      const int body = model.framePosition(contacts_[static_cast<std::size_t>(i)].frame);
+      d.residual.segment<3>(6 * i) = d.data.linearAcceleration[static_cast<std::size_t>(body)] - d.data.linearAcceleration[0];
+      d.residual.segment<3>(6 * i + 3) = d.data.angularAcceleration[static_cast<std::size_t>(body)] - d.data.angularAcceleration[0];
+      frameJacobian(model, d.data, body, Vector3::Zero(), d.jacobian);
+      d.spatial.middleRows<6>(6 * i) = d.jacobian;
+    }
+    for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
+    keepOpen(d, set);
+    d.lu.compute(d.closing);
+    d.step.noalias() = d.lu.solve(d.residual);
+    for (int k = 0; k < c; ++k)
+      if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
   }
-  // Accelerations: the spatial acceleration with q̈_C = 0, against the fixed world's (the
-  // reference body's, gravity folded in), then S_C q̈_C cancels the difference. S is the frame
-  // Jacobian about the world origin.
-  for (int k = 0; k < c; ++k)
-    if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = 0.0;
-  inverseDynamics(model, d.data, q, v, a);
-  for (int i = 0; i < contactCount(); ++i) {
-    const int body = model.framePosition(contacts_[static_cast<std::size_t>(i)].frame);
-    d.residual.segment<3>(6 * i) = d.data.linearAcceleration[static_cast<std::size_t>(body)] - d.data.linearAcceleration[0];
-    d.residual.segment<3>(6 * i + 3) = d.data.angularAcceleration[static_cast<std::size_t>(body)] - d.data.angularAcceleration[0];
-    frameJacobian(model, d.data, body, Vector3::Zero(), d.jacobian);
-    d.spatial.middleRows<6>(6 * i) = d.jacobian;
-  }
-  for (int k = 0; k < c; ++k) d.closing.col(k) = d.spatial.col(closing_[static_cast<std::size_t>(k)]);
-  keepOpen(d, set);
-  d.lu.compute(d.closing);
-  d.step.noalias() = d.lu.solve(d.residual);
-  for (int k = 0; k < c; ++k)
-    if (closed(k)) a[closing_[static_cast<std::size_t>(k)]] = -d.step[k];
   if (map) writeMap(model, d, q, v, a, *map, set, order);
   return true;
 }
@@ -339,7 +335,7 @@ void ClosedChains::writeMap(const DynamicsModel& model, ClosedChainData& d, cons
                             const Eigen::Ref<const Eigen::VectorXd>& v, const Eigen::Ref<const Eigen::VectorXd>& a,
                             Eigen::MatrixXd& M, ClosureSet set, ClosureOrder order) const {
   const int c = closingCount(), n = model.jointCount();
-  auto closed = [&](int k) { return ((set >> contactOf_[static_cast<std::size_t>(closing_[static_cast<std::size_t>(k)])]) & 1U) != 0; };
+  auto closed = [&](int k) { return closesIn(closing_[static_cast<std::size_t>(k)], set); };
   // ∂(q_C, q̇_C, q̈_C)/∂(q, q̇, q̈) by the implicit function theorem, at the closed state.
   inverseDynamics(model, d.data, q, v, a);
   for (int i = 0; i < contactCount(); ++i) {

@@ -200,9 +200,10 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
       out.columns.push_back(parameterCount_);
     };
 
-    // The task instants first, each a thread's (their differences, with closed chains a closure
-    // a probe, cost as much as several samples), the samples shared as threads come free: every
-    // slot is computed alike on any thread, so the sum below is the same whatever the schedule.
+    // The task instants first: each one's differences (with closed chains, a closure a probe)
+    // cost as much as several samples, so a thread takes each and the others start on the
+    // samples, shared as threads come free. Every slot is computed alike on any thread: the sum
+    // below is the same whatever the schedule.
 #pragma omp for schedule(dynamic) nowait
     for (int i = 0; i < static_cast<int>(taskBlocks_.size()); ++i) {
       const TaskSpec& spec = scenario_.tasks[static_cast<std::size_t>(taskOfInstant_[static_cast<std::size_t>(i)])];
