@@ -5,8 +5,8 @@
 // value lies within the fraction of their range about its middle.
 #include <catch2/catch.hpp>
 
-#include <random>
 
+#include "common/perturbed_motion.hpp"
 #include "common/screened_rows.hpp"
 #include "common/scenario_variant.hpp"
 #include "common/temp_dir.hpp"
@@ -22,10 +22,7 @@ TEST_CASE("closing-row screening: the screened problem is the full one without t
   s.samples = 12;
   s.outputSamples = 12;
   MotionProblem full(s);
-  Eigen::VectorXd x = full.initialPoint(s.start, s.end);
-  std::mt19937 random(5);
-  std::uniform_real_distribution<double> u(-0.3, 0.3);
-  for (int i = 0; i < full.parametrization().parameterCount(); ++i) x[i] += u(random);
+  const Eigen::VectorXd x = test::perturbedMotion(full, 0.3, 5);
 
   // Which rows a fraction leaves out, from the full problem's own row values and bounds.
   const double fraction = 0.2;
