@@ -76,6 +76,9 @@ class ContactForceFormulation {
   virtual void variableBounds(Eigen::Ref<Eigen::VectorXd> lower, Eigen::Ref<Eigen::VectorXd> upper) const {
     (void)lower, (void)upper;
   }
+  /// The size of one unit of each of its variables for the outer solver, in the whole x's
+  /// units (ones on entry; NlpProblem::variableUnits).
+  virtual void variableUnits(Eigen::Ref<Eigen::VectorXd> units) const { (void)units; }
   /// Sample s's force columns: the terms (contact, weight, first local column; six columns
   /// each) and each local column's variable.
   virtual void layOutForceColumns(int s, std::vector<LocalForceTerm>& terms, std::vector<int>& columns) const {

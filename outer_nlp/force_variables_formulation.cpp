@@ -23,7 +23,8 @@ namespace {
 class ForceVariablesFormulation final : public ContactForceFormulation {
  public:
   ForceVariablesFormulation(const FormulationContext& c, ContactForceParametrization::Layout layout)
-      : scenario_(c.scenario), outputs_(c.outputs), support_(c.support), contactRows_(c.contactRows), layout_(layout) {
+      : scenario_(c.scenario), outputs_(c.outputs), support_(c.support), contactRows_(c.contactRows), layout_(layout),
+        firstVariable_(c.firstVariable), weight_(c.weight) {
     if (!scenario_.contacts.empty())
       forces_.emplace(layout, c.windows, c.sampleTimes, c.active, scenario_.forceControlPoints, c.firstVariable);
   }
@@ -42,6 +43,13 @@ class ForceVariablesFormulation final : public ContactForceFormulation {
         for (const ContactForceParametrization::Term& t : forces_->terms(i, s))
           lower.segment(t.variable + size, 6 - size).setZero(), upper.segment(t.variable + size, 6 - size).setZero();
     }
+  }
+
+  void variableUnits(Eigen::Ref<Eigen::VectorXd> units) const override {
+    // `force_units: weight`: the wrenches in units of the robot's weight m g (newtons, and
+    // newton-metres for the moments), next to the joints' radians (docs/theory/outer-problem.md,
+    // "Units of the force variables").
+    if (forces_ && scenario_.forcesInWeights) units.segment(firstVariable_, forces_->variableCount()).setConstant(weight_);
   }
 
   void layOutForceColumns(int s, std::vector<LocalForceTerm>& terms, std::vector<int>& columns) const override {
@@ -128,6 +136,8 @@ class ForceVariablesFormulation final : public ContactForceFormulation {
   const ContactAdmissibilityRows& support_;
   const std::vector<ContactAdmissibilityRows>& contactRows_;
   ContactForceParametrization::Layout layout_;
+  int firstVariable_ = 0;
+  double weight_ = 0.0;  ///< m g [N]
   std::optional<ContactForceParametrization> forces_;  ///< none without environment contacts
 };
 

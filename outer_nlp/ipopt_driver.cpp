@@ -1,8 +1,9 @@
 // SPDX-License-Identifier: BSD-3-Clause
 // Ipopt as the outer solver (outer_solver.hpp): exact first derivatives, the declared sparse
 // Jacobian, a limited-memory Hessian unless the settings say otherwise, the scenario's options
-// on top of ours (docs/reference/scenario-file.md, "Ipopt options we set"). Registered as
-// "ipopt" in outer_solver.cpp.
+// on top of ours (docs/reference/scenario-file.md, "Ipopt options we set"), the variables in
+// the problem's units for Ipopt (NlpProblem::variableUnits). Registered as "ipopt" in
+// outer_solver.cpp.
 #include "outer_nlp/outer_solver.hpp"
 
 #include <IpIpoptApplication.hpp>
@@ -16,6 +17,7 @@
 #include <chrono>
 #include <iterator>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/errors.hpp"
 
@@ -91,6 +93,10 @@ class ProblemTnlp final : public Ipopt::TNLP {
         clock_(std::chrono::steady_clock::now()), hessian_(hessian) {
     problem_.variableBounds(xLower_, xUpper_);
     problem_.constraintBounds(gLower_, gUpper_);
+    problem_.variableUnits(units_);
+    if (units_.size() != start_.size() || !(units_.array() > 0.0).all() || !units_.allFinite())
+      throw std::logic_error("ipopt driver: the problem's variable units must be positive and finite, one a variable");
+    scaled_ = (units_.array() != 1.0).any();
   }
 
   /// finalize_solution was called: the outcome holds Ipopt's status.
@@ -107,14 +113,14 @@ class ProblemTnlp final : public Ipopt::TNLP {
   }
   bool get_bounds_info(Index n, Number* xL, Number* xU, Index m, Number* gL, Number* gU) override {
     auto finite = [](double v) { return std::isfinite(v) ? v : (v > 0 ? 2e19 : -2e19); };
-    for (Index i = 0; i < n; ++i) xL[i] = finite(xLower_[i]), xU[i] = finite(xUpper_[i]);
+    for (Index i = 0; i < n; ++i) xL[i] = finite(xLower_[i] / units_[i]), xU[i] = finite(xUpper_[i] / units_[i]);
     for (Index i = 0; i < m; ++i) gL[i] = finite(gLower_[i]), gU[i] = finite(gUpper_[i]);
     return true;
   }
   bool get_starting_point(Index n, bool initX, Number* x, bool initZ, Number*, Number*, Index, bool initLambda,
                           Number*) override {
     if (!initX || initZ || initLambda) return false;
-    Eigen::Map<Eigen::VectorXd>(x, n) = start_;
+    Eigen::Map<Eigen::VectorXd>(x, n) = start_.cwiseQuotient(units_);
     return true;
   }
   bool eval_f(Index n, const Number* x, bool, Number& value) override {
@@ -129,6 +135,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
       ++outcome_.gradientEvaluations;
       const Clock clock(outcome_.timings.derivatives);
       problem_.objectiveGradient(copy(x, n), buffer_);
+      if (scaled_) buffer_.array() *= units_.array();
       Eigen::Map<Eigen::VectorXd>(gradient, n) = buffer_;
     });
   }
@@ -149,6 +156,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
       ++outcome_.jacobianEvaluations;
       const Clock clock(outcome_.timings.derivatives);
       problem_.jacobianValues(copy(x, n), buffer_);
+      if (scaled_)
+        for (Index k = 0; k < nnz; ++k) buffer_[k] *= units_[problem_.jacobianColumns()[k]];
       Eigen::Map<Eigen::VectorXd>(values, nnz) = buffer_;
     });
   }
@@ -164,6 +173,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
     return guarded([&] {
       const Clock clock(outcome_.timings.hessian);
       problem_.lagrangianHessian(copy(x, n), objectiveFactor, Eigen::Map<const Eigen::VectorXd>(lambda, m), buffer_);
+      for (Index r = 0; scaled_ && r < curved; ++r)
+        for (Index c = 0; c <= r; ++c) buffer_[lowerTriangleIndex(r, c)] *= units_[r] * units_[c];
       Eigen::Map<Eigen::VectorXd>(values, buffer_.size()) = buffer_;
     });
   }
@@ -208,9 +219,15 @@ class ProblemTnlp final : public Ipopt::TNLP {
     const Ipopt::SmartPtr<const Ipopt::Vector> x = original->NLP_scaling()->unapply_vector_scaling_x(data->curr()->x());
     iterate_.resize(start_.size());
     adapter->ResortX(*x, iterate_.data());
+    if (scaled_) iterate_.array() *= units_.array();
     return true;
   }
-  static Eigen::VectorXd copy(const Number* x, Index n) { return Eigen::Map<const Eigen::VectorXd>(x, n); }
+  /// Ipopt's x in the problem's own units.
+  Eigen::VectorXd copy(const Number* x, Index n) const {
+    Eigen::VectorXd ours = Eigen::Map<const Eigen::VectorXd>(x, n);
+    if (scaled_) ours.array() *= units_.array();
+    return ours;
+  }
   template <class F>
   bool guarded(F&& f) {
     // An exception must not cross Ipopt's C++ frames: report it as a failed evaluation.
@@ -230,6 +247,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
   std::chrono::steady_clock::time_point clock_;
   bool hessian_;
   Eigen::VectorXd iterate_;
+  Eigen::VectorXd units_;  ///< NlpProblem::variableUnits: Ipopt works on x / units_
+  bool scaled_ = false;    ///< some unit is not 1
   bool finalized_ = false;
 };
 

@@ -31,7 +31,9 @@ namespace mcopt {
 namespace {
 
 /// Forward-difference step for a variable of magnitude `value` (as the generic differences).
-inline double differenceStep(double value) { return 1e-6 * std::max(1.0, std::abs(value)); }
+/// A forward difference's step for a variable of that value and unit (NlpProblem::variableUnits):
+/// 1e-6 of its size, at least of its unit.
+inline double differenceStep(double value, double unit = 1.0) { return 1e-6 * std::max(unit, std::abs(value)); }
 
 }  // namespace
 
@@ -350,7 +352,8 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
                             : c < 2 * n     ? &w.v[c - n]
                             : c < 3 * n     ? &w.a[c - 2 * n]
                                             : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
-        const double saved = *component, step = differenceStep(saved);
+        const double saved = *component,
+                     step = differenceStep(saved, state ? 1.0 : units_[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]]);
         *component = saved + step;
         if (closure_ && state) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed);
         sampleOutputs(s, h.probeX, true, w, probe);

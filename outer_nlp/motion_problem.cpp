@@ -299,6 +299,7 @@ MotionProblem::MotionProblem(const Scenario& scenario, MotionProblemOptions opti
   // The cost terms' own variables (the epigraph's slacks) come last.
   variableCount_ = slackStart_;
   forEachCostVariableBlock([&](const CostTerm&, int, int, int size) { variableCount_ += size; });
+  variableUnits(units_);
   buildStructure();
 }
 

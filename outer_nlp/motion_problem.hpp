@@ -223,6 +223,8 @@ class MotionProblem final : public NlpProblem {
 
   void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
   void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override;
+  /// Ones, except the formulation's force variables (ContactForceFormulation::variableUnits).
+  void variableUnits(Eigen::VectorXd& units) const override;
 
   /// The motion from `start` to `end` (inner control points spaced linearly), the initial
   /// duration, force variables fitted to the inner problem's wrenches along that motion
@@ -518,6 +520,7 @@ class MotionProblem final : public NlpProblem {
   std::vector<std::vector<int>> taskJoints_;     ///< per task instant: joints that move the task's body
   ContactAdmissibilityRows support_;
   double weight_ = 0.0;                   ///< m g [N]
+  Eigen::VectorXd units_;                 ///< variableUnits(): the outer solver's and the difference steps'
 
   ConstraintTerms terms_;  ///< the row families (constraint_term.hpp), made once the layout above is known
   CostTerms costs_;        ///< the objective's terms (cost_term.hpp)

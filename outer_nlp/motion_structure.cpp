@@ -170,6 +170,11 @@ void MotionProblem::variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& uppe
   });
 }
 
+void MotionProblem::variableUnits(Eigen::VectorXd& units) const {
+  units.setOnes(variableCount_);
+  formulation_->variableUnits(units);
+}
+
 void MotionProblem::constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const {
   lower.resize(constraintCount());
   upper.resize(constraintCount());

@@ -19,6 +19,11 @@ class NlpProblem {
   virtual const Eigen::VectorXi& jacobianColumns() const = 0;
   virtual void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const = 0;
   virtual void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const = 0;
+  /// The size of one unit of each variable for the solver (`units` resized to variableCount(),
+  /// every entry positive): the solver works on x_i / unit_i, so that variables of different
+  /// kinds (radians, newtons) come to it at comparable sizes; every function here still takes
+  /// x in the problem's own units. Ones unless the problem says otherwise.
+  virtual void variableUnits(Eigen::VectorXd& units) const { units.setOnes(variableCount()); }
   virtual double objective(const Eigen::VectorXd& x) = 0;
   virtual void objectiveGradient(const Eigen::VectorXd& x, Eigen::VectorXd& gradient) = 0;
   virtual void constraints(const Eigen::VectorXd& x, Eigen::VectorXd& values) = 0;

@@ -166,7 +166,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                           {"description", "robot", "actuators", "contact_surfaces", "postures", "reference_body",
                            "reference_pose", "gravity", "contacts", "friction_sharpness", "duration", "samples",
                            "control_points", "output_samples", "objective", "limits", "tasks", "start", "end",
-                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "inner", "closure_tolerance",
+                           "initialisation", "hessian", "continuation", "solver", "contact_forces", "force_control_points", "force_units", "inner", "closure_tolerance",
                            "closure_reach_margin", "refine",
                            "allow_nonphysical_inertia"});
   Scenario s;
@@ -349,6 +349,12 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (contactForces) s.contactForces = contactForceFormulation(*contactForces).name;
   if (root["force_control_points"])
     s.forceControlPoints = yaml::integerAtLeast(file, root["force_control_points"], "force_control_points", 4);
+  if (root["force_units"]) {
+    const std::string units = yaml::text(file, root["force_units"], "force_units");
+    if (units != "newton" && units != "weight")
+      throw InputError(where(file, root["force_units"], "force_units") + "expected newton or weight, got '" + units + "'");
+    s.forcesInWeights = units == "weight";
+  }
   if (root["inner"]) readInnerSettings(file, root["inner"], s);
   if (root["initialisation"]) {
     const YAML::Node init = root["initialisation"];

@@ -99,6 +99,9 @@ struct Scenario {
   /// formulation's name (formulation_registry.hpp).
   std::string contactForces = "bilevel";
   int forceControlPoints = 9;      ///< per wrench spline (splines formulation), over its contact's window
+  /// `force_units: weight`: Ipopt sees the splines and variables formulations' force variables in
+  /// units of the robot's weight m g instead of newtons (NlpProblem::variableUnits).
+  bool forcesInWeights = false;
   MultiContactSettings inner;      ///< bilevel: contact model and inner solver
   SensitivitySettings sensitivity; ///< bilevel: KKT backend
   bool contactConstraints = true;  ///< unilaterality, friction cone and CoP of W0 at the samples

@@ -8,6 +8,7 @@
 
 #include <fstream>
 #include <iterator>
+#include <vector>
 
 #include "common/temp_dir.hpp"
 #include "core/errors.hpp"
@@ -87,7 +88,82 @@ class FixedThenDiscRosenbrock final : public NlpProblem {
   Eigen::VectorXi rows_ = Eigen::VectorXi::Zero(2), columns_ = (Eigen::VectorXi(2) << 1, 2).finished();
 };
 
+/// The same problem boxed in |x|, |y| ≤ 2 (inactive), in other units, u = (units_x x, units_y y),
+/// and saying so (variableUnits): Ipopt, working on u / units, sees the same problem whatever they are.
+class RescaledDiscRosenbrock final : public NlpProblem {
+ public:
+  explicit RescaledDiscRosenbrock(const Eigen::Vector2d& units) : units_(units) {}
+  const Eigen::Vector2d& units() const { return units_; }
+  int variableCount() const override { return 2; }
+  int constraintCount() const override { return 1; }
+  const Eigen::VectorXi& jacobianRows() const override { return rows_; }
+  const Eigen::VectorXi& jacobianColumns() const override { return columns_; }
+  void variableBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override {
+    lower = -2.0 * units(), upper = 2.0 * units();
+  }
+  void constraintBounds(Eigen::VectorXd& lower, Eigen::VectorXd& upper) const override {
+    disc_.constraintBounds(lower, upper);
+  }
+  void variableUnits(Eigen::VectorXd& u) const override { u = units(); }
+  double objective(const Eigen::VectorXd& v) override { return disc_.objective(disc(v)); }
+  void objectiveGradient(const Eigen::VectorXd& v, Eigen::VectorXd& g) override {
+    disc_.objectiveGradient(disc(v), g);
+    g = g.cwiseQuotient(units());
+  }
+  void constraints(const Eigen::VectorXd& v, Eigen::VectorXd& g) override { disc_.constraints(disc(v), g); }
+  void jacobianValues(const Eigen::VectorXd& v, Eigen::VectorXd& values) override {
+    disc_.jacobianValues(disc(v), values);
+    values = values.cwiseQuotient(units());
+  }
+  void lagrangianHessian(const Eigen::VectorXd& v, double objectiveFactor, const Eigen::Ref<const Eigen::VectorXd>& multipliers,
+                         Eigen::VectorXd& values) override {
+    // DiscRosenbrock's own (differences in x, y), in u: H_u = H / (unit_r unit_c).
+    disc_.lagrangianHessian(disc(v), objectiveFactor, multipliers, values);
+    for (int r = 0; r < 2; ++r)
+      for (int c = 0; c <= r; ++c) values[lowerTriangleIndex(r, c)] /= units()[r] * units()[c];
+  }
+  std::string rowName(int) const override { return "disc"; }
+  Eigen::VectorXd disc(const Eigen::VectorXd& v) const { return v.cwiseQuotient(units()); }
+
+ private:
+  Eigen::Vector2d units_;
+  DiscRosenbrock disc_;
+  Eigen::VectorXi rows_ = Eigen::VectorXi::Zero(2), columns_ = (Eigen::VectorXi(2) << 0, 1).finished();
+};
+
 }  // namespace
+
+TEST_CASE("Ipopt driver: a problem in other units, saying so, takes the same path in its own units", "[outer]") {
+  // Ipopt works on x / units: the rescaled disc is the plain one to it, iteration by
+  // iteration, if the driver scales the bounds, the start, the gradient, the Jacobian's
+  // columns and the Hessian, and reports every point back in the problem's units.
+  RescaledDiscRosenbrock plain(Eigen::Vector2d::Ones()), rescaled(Eigen::Vector2d(1000.0, 1e-3));
+  const Eigen::VectorXd start = (Eigen::VectorXd(2) << -0.5, 0.2).finished();
+  const Eigen::VectorXd units = rescaled.units();
+  for (const bool newton : {false, true}) {
+    INFO("Hessian by differences: " << newton);
+    OuterSolverSettings settings;
+    settings.problemHessian = newton;
+    std::vector<double> plainPath, rescaledPath;
+    const OuterOutcome a = solveOuter(plain, start, settings, [&](const IterationReport& r) {
+      if (r.iterate != nullptr) plainPath.push_back((*r.iterate)[0]);
+      return true;
+    });
+    const OuterOutcome b = solveOuter(rescaled, start.cwiseProduct(units), settings, [&](const IterationReport& r) {
+      if (r.iterate == nullptr) return true;
+      CHECK(rescaled.objective(*r.iterate) == Approx(r.objective).epsilon(1e-12));  // in the problem's units
+      rescaledPath.push_back((*r.iterate)[0] / units[0]);
+      return true;
+    });
+    CHECK(a.status == OuterStatus::Optimal);
+    CHECK(b.status == OuterStatus::Optimal);
+    CHECK(b.iterations == a.iterations);
+    REQUIRE(rescaledPath.size() == plainPath.size());
+    for (std::size_t k = 0; k < plainPath.size(); ++k) CHECK(rescaledPath[k] == Approx(plainPath[k]).epsilon(1e-9));
+    CHECK(b.x[0] == Approx(0.786415 * units[0]).epsilon(1e-5));
+    CHECK(b.x[1] == Approx(0.617698 * units[1]).epsilon(1e-5));
+  }
+}
 
 TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", "[outer]") {
   DiscRosenbrock problem;
@@ -124,6 +200,30 @@ TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-differe
                       option("output_file", log.string(), SolverOption::Type::Text),
                       option("file_print_level", "5", SolverOption::Type::Integer)};
   solveOuter(problem, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), settings, nullptr);
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK_THAT(text, Catch::Contains("Starting derivative checker for second derivatives"));
+  CHECK_THAT(text, Catch::Contains("No errors detected by derivative checker"));
+}
+
+TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the derivatives of a problem in other units", "[outer]") {
+  // It differences what Ipopt sees (x / units): the gradient, Jacobian and Hessian scaled alike.
+  RescaledDiscRosenbrock problem(Eigen::Vector2d(1000.0, 1e-3));
+  const test::TempDir dir;
+  OuterSolverSettings settings;
+  settings.problemHessian = true;
+  auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
+    SolverOption o;
+    o.name = name, o.text = text, o.type = type, o.origin = std::string(name) + ": ";
+    if (type == SolverOption::Type::Integer) o.integer = std::stoi(text);
+    return o;
+  };
+  const auto log = dir.path() / "ipopt.txt";
+  settings.options = {option("derivative_test", "second-order", SolverOption::Type::Text),
+                      option("max_iter", "0", SolverOption::Type::Integer),
+                      option("output_file", log.string(), SolverOption::Type::Text),
+                      option("file_print_level", "5", SolverOption::Type::Integer)};
+  solveOuter(problem, (Eigen::VectorXd(2) << 300.0, 4e-4).finished(), settings, nullptr);
   std::ifstream in(log);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK_THAT(text, Catch::Contains("Starting derivative checker for second derivatives"));

@@ -11,6 +11,8 @@
 #include "common/finite_differences.hpp"
 #include "common/nlp_jacobian.hpp"
 #include "common/perturbed_motion.hpp"
+#include "common/scenario_variant.hpp"
+#include "common/temp_dir.hpp"
 #include "common/test_support.hpp"
 #include "core/contact_maps.hpp"
 #include "core/trajectory_evaluation.hpp"
@@ -104,6 +106,43 @@ TEST_CASE("multi-contact outer problem: exact derivatives of every formulation",
       }
     }
   }
+}
+
+TEST_CASE("multi-contact outer problem: force_units: weight hands the outer solver the force variables in m g, nothing else",
+          "[outer][multi-contact]") {
+  for (const std::string& forces : contactForcesNames()) {
+    for (const bool inWeights : {false, true}) {
+      Scenario s = weightShift(12);
+      s.contactForces = forces;
+      s.forcesInWeights = inWeights;
+      const MotionProblem problem(s);
+      Eigen::VectorXd units;
+      problem.variableUnits(units);
+      INFO(forces << (inWeights ? ", force_units: weight" : ", force_units: newton"));
+      REQUIRE(units.size() == problem.variableCount());
+      const int first = problem.forceVariableStart(), count = problem.forceVariableCount();
+      CHECK((forces == "bilevel") == (count == 0));
+      const double weight = s.robot.totalMass() * s.gravity.norm();
+      for (int i = 0; i < units.size(); ++i) {
+        const bool force = i >= first && i < first + count;
+        CHECK(units[i] == (force && inWeights ? weight : 1.0));
+      }
+    }
+  }
+}
+
+TEST_CASE("multi-contact outer problem: force_units is read from the file, and a unit it does not know is refused with the field named",
+          "[outer][multi-contact]") {
+  const test::TempDir dir;
+  const auto source = test::sourceDir() / "scenarios/hrp2_weight_shift.yaml";
+  CHECK_FALSE(loadScenario(source).forcesInWeights);
+  const auto weight = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "weight"; }, "weight.yaml");
+  CHECK(loadScenario(weight).forcesInWeights);
+  const auto newton = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "newton"; }, "newton.yaml");
+  CHECK_FALSE(loadScenario(newton).forcesInWeights);
+  const auto bad = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "kilogram"; }, "bad.yaml");
+  CHECK_THROWS_WITH(loadScenario(bad), Catch::Contains("bad.yaml") && Catch::Contains("force_units") &&
+                                           Catch::Contains("expected newton or weight, got 'kilogram'"));
 }
 
 TEST_CASE("multi-contact outer problem: a point hand (a force alone) gets exact derivatives and carries no moment",
