@@ -44,6 +44,7 @@ struct RunOptions {
   // The command line's text of the overrides (ScenarioOverrides types them): "" when not given.
   std::string configurationOptimisation;  ///< "on" or "off"
   std::string contactForces;              ///< a formulation
+  std::string forceUnits;                 ///< "newton" or "weight"
   std::optional<int> maxIterations;
   std::string innerSolver;                ///< an inner solver
   std::string hessian;                    ///< a Hessian option: every stage's
@@ -98,6 +99,7 @@ int runMotion(const RunOptions& o) {
   ScenarioOverrides overrides;
   if (!o.configurationOptimisation.empty()) overrides.configurationOptimisation = o.configurationOptimisation == "on";
   overrides.contactForces = contactForces;
+  if (!o.forceUnits.empty()) overrides.forcesInWeights = o.forceUnits == "weight";
   overrides.maxIterations = o.maxIterations;
   if (!o.innerSolver.empty()) overrides.innerSolver = o.innerSolver;
   if (!o.hessian.empty()) overrides.hessian = parseHessianOption(o.hessian);  // a member of the list: checked by CLI11
@@ -315,6 +317,10 @@ Runner addRun(CLI::App& command) {
   command.add_option("--contact-forces", o->contactForces,
                      alternatives(contactForcesNames()) + ": override the scenario's contact_forces (formulation.md §9)")
       ->check(CLI::IsMember(contactForcesNames()));
+  command.add_option("--force-units", o->forceUnits,
+                     "newton or weight: override the scenario's force_units, the unit in which Ipopt sees the splines and "
+                     "variables formulations' force variables (docs/theory/outer-problem.md, \"Units of the force variables\")")
+      ->check(CLI::IsMember({"newton", "weight"}));
   command.add_option("--max-iterations", o->maxIterations,
                      "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,

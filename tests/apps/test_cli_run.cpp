@@ -1293,6 +1293,37 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
   CHECK_THAT(r.errors, Contains(bad.string() + ": contacts[0].wrenches[0]"));
 }
 
+TEST_CASE("run: --force-units hands Ipopt the force variables in weights, recorded, and leaves the bilevel problem alone",
+          "[cli][run][multi-contact]") {
+  const test::TempDir dir;
+  const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 8;
+    root["continuation"] = YAML::Load("[]");
+  }, "weight_shift.yaml");
+  // The objective along the first iterations: the same problem, and from the same start, so the
+  // first entry agrees; after it the steps are Ipopt's in other units.
+  auto run = [&](const std::string& forces, const std::string& units) {
+    const auto out = dir.path() / (forces + "_" + (units.empty() ? "file" : units));
+    const auto r = test::runMcopt("run " + test::quoted(scenario) + " --contact-forces " + forces +
+                                  (units.empty() ? "" : " --force-units " + units) + " --out " + test::quoted(out) +
+                                  " --max-iterations 3 --configuration-optimisation off");
+    INFO(r.all());
+    REQUIRE(r.exitCode == 4);
+    const Json result = readJson(out / "result.json");
+    CHECK(result["force_units"] == (units.empty() ? "newton" : units));
+    std::vector<double> objective;
+    for (const Json& h : result["history"]) objective.push_back(h["objective"].get<double>());
+    return objective;
+  };
+  const std::vector<double> newtons = run("variables", ""), weights = run("variables", "weight");
+  REQUIRE(newtons.size() == 4);
+  REQUIRE(weights.size() == 4);
+  CHECK(weights[0] == Approx(newtons[0]).epsilon(1e-12));  // x / m g · m g: the start to rounding
+  CHECK(weights.back() != newtons.back());
+  CHECK(run("variables", "newton") == newtons);
+  CHECK(run("bilevel", "weight") == run("bilevel", ""));  // no force variables: the same iterates, to the bit
+}
+
 TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][run][multi-contact]") {
   const test::TempDir dir;
   const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
