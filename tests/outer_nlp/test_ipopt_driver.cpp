@@ -131,6 +131,28 @@ class RescaledDiscRosenbrock final : public NlpProblem {
   Eigen::VectorXi rows_ = Eigen::VectorXi::Zero(2), columns_ = (Eigen::VectorXi(2) << 0, 1).finished();
 };
 
+/// Ipopt's log of its second-order derivative checker at `start`, with the problem's Hessian
+/// (no iteration).
+std::string secondOrderCheck(NlpProblem& problem, const Eigen::VectorXd& start) {
+  const test::TempDir dir;
+  OuterSolverSettings settings;
+  settings.problemHessian = true;
+  auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
+    SolverOption o;
+    o.name = name, o.text = text, o.type = type, o.origin = std::string(name) + ": ";
+    if (type == SolverOption::Type::Integer) o.integer = std::stoi(text);
+    return o;
+  };
+  const auto log = dir.path() / "ipopt.txt";
+  settings.options = {option("derivative_test", "second-order", SolverOption::Type::Text),
+                      option("max_iter", "0", SolverOption::Type::Integer),
+                      option("output_file", log.string(), SolverOption::Type::Text),
+                      option("file_print_level", "5", SolverOption::Type::Integer)};
+  solveOuter(problem, start, settings, nullptr);
+  std::ifstream in(log);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 }  // namespace
 
 TEST_CASE("Ipopt driver: a problem in other units, saying so, takes the same path in its own units", "[outer]") {
@@ -184,24 +206,7 @@ TEST_CASE("Ipopt driver: both Hessian modes reach a known constrained optimum", 
 
 TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-difference Hessian", "[outer]") {
   DiscRosenbrock problem;
-  const test::TempDir dir;
-  OuterSolverSettings settings;
-  settings.problemHessian = true;
-  auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
-    SolverOption o;
-    o.name = name, o.text = text, o.type = type, o.origin = std::string(name) + ": ";
-    if (type == SolverOption::Type::Integer) o.integer = std::stoi(text);
-    if (type == SolverOption::Type::Number) o.number = std::stod(text);
-    return o;
-  };
-  const auto log = dir.path() / "ipopt.txt";
-  settings.options = {option("derivative_test", "second-order", SolverOption::Type::Text),
-                      option("max_iter", "0", SolverOption::Type::Integer),
-                      option("output_file", log.string(), SolverOption::Type::Text),
-                      option("file_print_level", "5", SolverOption::Type::Integer)};
-  solveOuter(problem, (Eigen::VectorXd(2) << 0.3, 0.4).finished(), settings, nullptr);
-  std::ifstream in(log);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = secondOrderCheck(problem, (Eigen::VectorXd(2) << 0.3, 0.4).finished());
   CHECK_THAT(text, Catch::Contains("Starting derivative checker for second derivatives"));
   CHECK_THAT(text, Catch::Contains("No errors detected by derivative checker"));
 }
@@ -209,23 +214,7 @@ TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the finite-differe
 TEST_CASE("Ipopt driver: Ipopt's second-order checker accepts the derivatives of a problem in other units", "[outer]") {
   // It differences what Ipopt sees (x / units): the gradient, Jacobian and Hessian scaled alike.
   RescaledDiscRosenbrock problem(Eigen::Vector2d(1000.0, 1e-3));
-  const test::TempDir dir;
-  OuterSolverSettings settings;
-  settings.problemHessian = true;
-  auto option = [](const char* name, const std::string& text, SolverOption::Type type) {
-    SolverOption o;
-    o.name = name, o.text = text, o.type = type, o.origin = std::string(name) + ": ";
-    if (type == SolverOption::Type::Integer) o.integer = std::stoi(text);
-    return o;
-  };
-  const auto log = dir.path() / "ipopt.txt";
-  settings.options = {option("derivative_test", "second-order", SolverOption::Type::Text),
-                      option("max_iter", "0", SolverOption::Type::Integer),
-                      option("output_file", log.string(), SolverOption::Type::Text),
-                      option("file_print_level", "5", SolverOption::Type::Integer)};
-  solveOuter(problem, (Eigen::VectorXd(2) << 300.0, 4e-4).finished(), settings, nullptr);
-  std::ifstream in(log);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = secondOrderCheck(problem, (Eigen::VectorXd(2) << 300.0, 4e-4).finished());
   CHECK_THAT(text, Catch::Contains("Starting derivative checker for second derivatives"));
   CHECK_THAT(text, Catch::Contains("No errors detected by derivative checker"));
 }
