@@ -30,9 +30,9 @@ namespace mcopt {
 
 namespace {
 
-/// Forward-difference step for a variable of magnitude `value` (as the generic differences).
-/// A forward difference's step for a variable of that value and unit (NlpProblem::variableUnits):
-/// 1e-6 of its size, at least of its unit.
+/// Forward-difference step for a variable of magnitude `value` and unit `unit`
+/// (NlpProblem::variableUnits): 1e-6 of its size, at least of its unit (with units of one, as
+/// the generic differences).
 inline double differenceStep(double value, double unit = 1.0) { return 1e-6 * std::max(unit, std::abs(value)); }
 
 }  // namespace
