@@ -156,8 +156,10 @@ class ProblemTnlp final : public Ipopt::TNLP {
       ++outcome_.jacobianEvaluations;
       const Clock clock(outcome_.timings.derivatives);
       problem_.jacobianValues(copy(x, n), buffer_);
-      if (scaled_)
-        for (Index k = 0; k < nnz; ++k) buffer_[k] *= units_[problem_.jacobianColumns()[k]];
+      if (scaled_) {
+        const Eigen::VectorXi& columns = problem_.jacobianColumns();
+        for (Index k = 0; k < nnz; ++k) buffer_[k] *= units_[columns[k]];
+      }
       Eigen::Map<Eigen::VectorXd>(values, nnz) = buffer_;
     });
   }
@@ -173,8 +175,8 @@ class ProblemTnlp final : public Ipopt::TNLP {
     return guarded([&] {
       const Clock clock(outcome_.timings.hessian);
       problem_.lagrangianHessian(copy(x, n), objectiveFactor, Eigen::Map<const Eigen::VectorXd>(lambda, m), buffer_);
-      for (Index r = 0; scaled_ && r < curved; ++r)
-        for (Index c = 0; c <= r; ++c) buffer_[lowerTriangleIndex(r, c)] *= units_[r] * units_[c];
+      for (Index r = 0, k = 0; scaled_ && r < curved; ++r)
+        for (Index c = 0; c <= r; ++c) buffer_[k++] *= units_[r] * units_[c];
       Eigen::Map<Eigen::VectorXd>(values, buffer_.size()) = buffer_;
     });
   }

@@ -28,15 +28,6 @@
 
 namespace mcopt {
 
-namespace {
-
-/// Forward-difference step for a variable of magnitude `value` and unit `unit`
-/// (NlpProblem::variableUnits): 1e-6 of its size, at least of its unit (with units of one, as
-/// the generic differences).
-inline double differenceStep(double value, double unit = 1.0) { return 1e-6 * std::max(unit, std::abs(value)); }
-
-}  // namespace
-
 void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                       const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
   if (hessian_ == HessianOption::SampleDifferences || hessian_ == HessianOption::ConvexSampleDifferences ||
@@ -347,13 +338,13 @@ void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double ob
           h.stateHessian.col(c).head(d).setZero();
           continue;
         }
-        // Perturb one state component (or force variable), evaluate the sample there.
+        // Perturb one state component (or force variable, by a step in its own unit), evaluate the sample there.
+        const int force = state ? -1 : b.forceColumns[static_cast<std::size_t>(c - 3 * n)];
         double* component = c < n           ? &w.q[c]
                             : c < 2 * n     ? &w.v[c - n]
                             : c < 3 * n     ? &w.a[c - 2 * n]
-                                            : &h.probeX[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]];
-        const double saved = *component,
-                     step = differenceStep(saved, state ? 1.0 : units_[b.forceColumns[static_cast<std::size_t>(c - 3 * n)]]);
+                                            : &h.probeX[force];
+        const double saved = *component, step = differenceStep(saved, state ? 1.0 : units_[force]);
         *component = saved + step;
         if (closure_ && state) closure_->close(model_, w.closure, w.q, w.v, w.a, &h.probeMap, b.closed);
         sampleOutputs(s, h.probeX, true, w, probe);

@@ -18,14 +18,14 @@ void NlpProblem::lagrangianGradient(const Eigen::VectorXd& x, double objectiveFa
 void NlpProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                    const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
   // Column c = (∇L(x + h e_c) − ∇L(x)) / h, then symmetrised. Forward differences: half the
-  // evaluations of central ones, and Newton's steps do not need more than their ~1e-6
-  // relative accuracy (h = 1e-6 balances truncation and round-off).
+  // evaluations of central ones (differenceStep).
   const int curved = nonlinearVariableCount();
-  Eigen::VectorXd point = x, base, plus;
+  Eigen::VectorXd point = x, base, plus, units;
+  variableUnits(units);
   lagrangianGradient(point, objectiveFactor, multipliers, base);
   Eigen::MatrixXd columns(curved, curved);
   for (int c = 0; c < curved; ++c) {
-    const double saved = point[c], h = 1e-6 * std::max(1.0, std::abs(saved));
+    const double saved = point[c], h = differenceStep(saved, units[c]);
     point[c] = saved + h;
     lagrangianGradient(point, objectiveFactor, multipliers, plus);
     point[c] = saved;

@@ -5,6 +5,8 @@
 // configuration (static posture) problem both take this form; ipopt_driver solves it.
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace mcopt {
@@ -47,6 +49,11 @@ class NlpProblem {
  private:
   Eigen::VectorXd jacobianScratch_;
 };
+
+/// A forward difference's step for a variable of magnitude `value` and unit `unit`
+/// (NlpProblem::variableUnits): 1e-6 of its size, at least of its unit. h = 1e-6 balances
+/// truncation and round-off, and Newton's steps need no more than its ~1e-6 relative accuracy.
+inline double differenceStep(double value, double unit = 1.0) { return 1e-6 * std::max(unit, std::abs(value)); }
 
 /// Index of entry (row, column), column ≤ row, in a dense lower triangle stored row by row.
 inline Eigen::Index lowerTriangleIndex(Eigen::Index row, Eigen::Index column) { return row * (row + 1) / 2 + column; }
