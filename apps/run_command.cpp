@@ -99,7 +99,7 @@ int runMotion(const RunOptions& o) {
   ScenarioOverrides overrides;
   if (!o.configurationOptimisation.empty()) overrides.configurationOptimisation = o.configurationOptimisation == "on";
   overrides.contactForces = contactForces;
-  if (!o.forceUnits.empty()) overrides.forcesInWeights = o.forceUnits == "weight";
+  if (!o.forceUnits.empty()) overrides.forceUnits = parseForceUnits(o.forceUnits);  // a member of the list: checked by CLI11
   overrides.maxIterations = o.maxIterations;
   if (!o.innerSolver.empty()) overrides.innerSolver = o.innerSolver;
   if (!o.hessian.empty()) overrides.hessian = parseHessianOption(o.hessian);  // a member of the list: checked by CLI11
@@ -320,7 +320,7 @@ Runner addRun(CLI::App& command) {
   command.add_option("--force-units", o->forceUnits,
                      "newton or weight: override the scenario's force_units, the unit in which Ipopt sees the splines and "
                      "variables formulations' force variables (docs/theory/outer-problem.md, \"Units of the force variables\")")
-      ->check(CLI::IsMember({"newton", "weight"}));
+      ->check(CLI::IsMember(forceUnitsNames()));
   command.add_option("--max-iterations", o->maxIterations,
                      "override Ipopt's max_iter for the motion (each continuation stage: at most this many)");
   command.add_option("--inner-solver", o->innerSolver,

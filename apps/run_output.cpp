@@ -92,7 +92,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
   result["energy_form"] = scenario.energyForm == EnergyForm::Epigraph ? "epigraph" : "smooth_max";
   result["energy_fine"] = numberOrNull(r.fineEnergy);
   result["contact_forces"] = scenario.contactForces;
-  result["force_units"] = scenario.forcesInWeights ? "weight" : "newton";
+  result["force_units"] = toString(scenario.forceUnits);
   result["joint_names"] = robot.jointNames();
   result["reference_body"] = scenario.referenceBody;
   // What a result's motion is of, so that it can be drawn again (mcopt replay) from anywhere.

@@ -49,7 +49,7 @@ class ForceVariablesFormulation final : public ContactForceFormulation {
     // `force_units: weight`: the wrenches in units of the robot's weight m g (newtons, and
     // newton-metres for the moments), next to the joints' radians (docs/theory/outer-problem.md,
     // "Units of the force variables").
-    if (forces_ && scenario_.forcesInWeights) units.segment(firstVariable_, forces_->variableCount()).setConstant(weight_);
+    if (forces_ && scenario_.forceUnits == ForceUnits::Weight) units.segment(firstVariable_, forces_->variableCount()).setConstant(weight_);
   }
 
   void layOutForceColumns(int s, std::vector<LocalForceTerm>& terms, std::vector<int>& columns) const override {

@@ -350,10 +350,11 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (root["force_control_points"])
     s.forceControlPoints = yaml::integerAtLeast(file, root["force_control_points"], "force_control_points", 4);
   if (root["force_units"]) {
-    const std::string units = yaml::text(file, root["force_units"], "force_units");
-    if (units != "newton" && units != "weight")
-      throw InputError(where(file, root["force_units"], "force_units") + "expected newton or weight, got '" + units + "'");
-    s.forcesInWeights = units == "weight";
+    try {
+      s.forceUnits = parseForceUnits(yaml::text(file, root["force_units"], "force_units"));
+    } catch (const InputError& e) {
+      throw InputError(where(file, root["force_units"], "force_units") + e.what());
+    }
   }
   if (root["inner"]) readInnerSettings(file, root["inner"], s);
   if (root["initialisation"]) {

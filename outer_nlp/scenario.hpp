@@ -74,6 +74,15 @@ struct DurationSpec {
   bool free() const { return lower < upper; }
 };
 
+/// The unit in which the outer solver sees the splines and variables formulations' force
+/// variables (NlpProblem::variableUnits): newtons (and newton-metres), or the robot's weight m g.
+enum class ForceUnits { Newton, Weight };
+const char* toString(ForceUnits units);
+/// "newton" or "weight"; throws InputError otherwise.
+ForceUnits parseForceUnits(const std::string& name);
+/// Both names, in the order above (the choices of `mcopt run --force-units`).
+const std::vector<std::string>& forceUnitsNames();
+
 struct Scenario {
   std::filesystem::path file;
   std::filesystem::path contactSurfacesFile;  ///< the side file the contacts were read from
@@ -99,9 +108,8 @@ struct Scenario {
   /// formulation's name (formulation_registry.hpp).
   std::string contactForces = "bilevel";
   int forceControlPoints = 9;      ///< per wrench spline (splines formulation), over its contact's window
-  /// `force_units: weight`: Ipopt sees the splines and variables formulations' force variables in
-  /// units of the robot's weight m g instead of newtons (NlpProblem::variableUnits).
-  bool forcesInWeights = false;
+  /// `force_units`: the unit in which Ipopt sees the splines and variables formulations' force variables.
+  ForceUnits forceUnits = ForceUnits::Newton;
   MultiContactSettings inner;      ///< bilevel: contact model and inner solver
   SensitivitySettings sensitivity; ///< bilevel: KKT backend
   bool contactConstraints = true;  ///< unilaterality, friction cone and CoP of W0 at the samples

@@ -82,7 +82,7 @@ std::string postureWarning(const std::string& which, const PostureOutcome& p, co
 void applyOverrides(Scenario& scenario, const ScenarioOverrides& o) {
   if (o.configurationOptimisation) scenario.solve.configurationOptimisation = *o.configurationOptimisation;
   if (o.contactForces) scenario.contactForces = *o.contactForces;
-  if (o.forcesInWeights) scenario.forcesInWeights = *o.forcesInWeights;
+  if (o.forceUnits) scenario.forceUnits = *o.forceUnits;
   if (o.refineRounds) {
     if (*o.refineRounds < 0) throw InputError("refine: expected a number of rounds ≥ 0, got " + std::to_string(*o.refineRounds));
     scenario.solve.refineRounds = *o.refineRounds;

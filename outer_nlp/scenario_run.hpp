@@ -28,7 +28,7 @@ namespace mcopt {
 struct ScenarioOverrides {
   std::optional<bool> configurationOptimisation;
   std::optional<std::string> contactForces;  ///< formulation.md §9
-  std::optional<bool> forcesInWeights;       ///< `force_units`: weight (true) or newton
+  std::optional<ForceUnits> forceUnits;      ///< `force_units`
   std::optional<int> maxIterations;            ///< Ipopt's max_iter for the motion and the cap of every stage, ≥ 0
   std::optional<std::string> innerSolver;      ///< a registered inner solver (bilevel, formulation.md §7)
   /// The motion's and every continuation stage's Hessian. A stage left differing from the

@@ -110,6 +110,19 @@ const char* toString(HessianOption hessian) {
   return "?";
 }
 
+const char* toString(ForceUnits units) { return units == ForceUnits::Weight ? "weight" : "newton"; }
+
+ForceUnits parseForceUnits(const std::string& name) {
+  for (const ForceUnits units : {ForceUnits::Newton, ForceUnits::Weight})
+    if (name == toString(units)) return units;
+  throw InputError("expected " + alternatives(forceUnitsNames()) + ", got '" + name + "'");
+}
+
+const std::vector<std::string>& forceUnitsNames() {
+  static const std::vector<std::string> names = {toString(ForceUnits::Newton), toString(ForceUnits::Weight)};
+  return names;
+}
+
 HessianOption parseHessianOption(const std::string& name) {
   for (const HessianName& h : kHessianNames)
     if (name == h.name) return h.option;

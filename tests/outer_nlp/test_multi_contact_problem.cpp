@@ -114,7 +114,7 @@ TEST_CASE("multi-contact outer problem: force_units: weight hands the outer solv
     for (const bool inWeights : {false, true}) {
       Scenario s = weightShift(12);
       s.contactForces = forces;
-      s.forcesInWeights = inWeights;
+      s.forceUnits = inWeights ? ForceUnits::Weight : ForceUnits::Newton;
       const MotionProblem problem(s);
       Eigen::VectorXd units;
       problem.variableUnits(units);
@@ -135,11 +135,11 @@ TEST_CASE("multi-contact outer problem: force_units is read from the file, and a
           "[outer][multi-contact]") {
   const test::TempDir dir;
   const auto source = test::sourceDir() / "scenarios/hrp2_weight_shift.yaml";
-  CHECK_FALSE(loadScenario(source).forcesInWeights);
+  CHECK(loadScenario(source).forceUnits == ForceUnits::Newton);
   const auto weight = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "weight"; }, "weight.yaml");
-  CHECK(loadScenario(weight).forcesInWeights);
+  CHECK(loadScenario(weight).forceUnits == ForceUnits::Weight);
   const auto newton = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "newton"; }, "newton.yaml");
-  CHECK_FALSE(loadScenario(newton).forcesInWeights);
+  CHECK(loadScenario(newton).forceUnits == ForceUnits::Newton);
   const auto bad = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "kilogram"; }, "bad.yaml");
   CHECK_THROWS_WITH(loadScenario(bad), Catch::Contains("bad.yaml") && Catch::Contains("force_units") &&
                                            Catch::Contains("expected newton or weight, got 'kilogram'"));
