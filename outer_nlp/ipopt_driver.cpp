@@ -97,6 +97,17 @@ class ProblemTnlp final : public Ipopt::TNLP {
     if (units_.size() != start_.size() || !(units_.array() > 0.0).all() || !units_.allFinite())
       throw std::logic_error("ipopt driver: the problem's variable units must be positive and finite, one a variable");
     scaled_ = (units_.array() != 1.0).any();
+    if (!hessian_) return;
+    problem_.hessianPattern(hessianRows_, hessianColumns_);
+    const int curved = problem_.nonlinearVariableCount();
+    bool valid = hessianColumns_.size() == hessianRows_.size();
+    for (std::size_t k = 0; valid && k < hessianRows_.size(); ++k) {
+      const int r = hessianRows_[k], c = hessianColumns_[k];
+      const bool ordered = k == 0 || r > hessianRows_[k - 1] || (r == hessianRows_[k - 1] && c > hessianColumns_[k - 1]);
+      valid = c >= 0 && c <= r && r < curved && ordered;
+    }
+    if (!valid)
+      throw std::logic_error("ipopt driver: the problem's Hessian pattern must list lower-triangle entries of its nonlinear variables once each, row by row");
   }
 
   /// finalize_solution was called: the outcome holds Ipopt's status.
@@ -106,8 +117,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
     n = problem_.variableCount();
     m = problem_.constraintCount();
     nnzJacobian = static_cast<Index>(problem_.jacobianRows().size());
-    const Index curved = problem_.nonlinearVariableCount();
-    nnzHessian = hessian_ ? curved * (curved + 1) / 2 : 0;  // dense lower triangle, or limited memory
+    nnzHessian = static_cast<Index>(hessianRows_.size());  // the problem's pattern; none with limited memory
     style = C_STYLE;
     return true;
   }
@@ -165,19 +175,20 @@ class ProblemTnlp final : public Ipopt::TNLP {
   }
   bool eval_h(Index n, const Number* x, bool, Number objectiveFactor, Index m, const Number* lambda, bool, Index,
               Index* rows, Index* cols, Number* values) override {
-    const Index curved = problem_.nonlinearVariableCount();
+    const std::size_t nnz = hessianRows_.size();
     if (values == nullptr) {
-      Index k = 0;
-      for (Index r = 0; r < curved; ++r)
-        for (Index c = 0; c <= r; ++c) rows[k] = r, cols[k] = c, ++k;
+      for (std::size_t k = 0; k < nnz; ++k) rows[k] = hessianRows_[k], cols[k] = hessianColumns_[k];
       return true;
     }
     return guarded([&] {
       const Clock clock(outcome_.timings.hessian);
+      // The problem's dense lower triangle, read at the pattern's entries (x / units: H_rc u_r u_c).
       problem_.lagrangianHessian(copy(x, n), objectiveFactor, Eigen::Map<const Eigen::VectorXd>(lambda, m), buffer_);
-      for (Index r = 0, k = 0; scaled_ && r < curved; ++r)
-        for (Index c = 0; c <= r; ++c) buffer_[k++] *= units_[r] * units_[c];
-      Eigen::Map<Eigen::VectorXd>(values, buffer_.size()) = buffer_;
+      for (std::size_t k = 0; k < nnz; ++k) {
+        const int r = hessianRows_[k], c = hessianColumns_[k];
+        const double value = buffer_[lowerTriangleIndex(r, c)];
+        values[k] = scaled_ ? value * (units_[r] * units_[c]) : value;
+      }
     });
   }
   bool intermediate_callback(Ipopt::AlgorithmMode mode, Index iteration, Number objective, Number primal, Number dual,
@@ -250,6 +261,7 @@ class ProblemTnlp final : public Ipopt::TNLP {
   bool hessian_;
   Eigen::VectorXd iterate_;
   Eigen::VectorXd units_;  ///< NlpProblem::variableUnits: Ipopt works on x / units_
+  std::vector<int> hessianRows_, hessianColumns_;  ///< NlpProblem::hessianPattern, read once a solve (none: limited memory)
   bool scaled_ = false;    ///< some unit is not 1
   bool finalized_ = false;
 };

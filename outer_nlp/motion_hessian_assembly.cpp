@@ -37,6 +37,33 @@ void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objective
     NlpProblem::lagrangianHessian(x, objectiveFactor, multipliers, values);
 }
 
+void MotionProblem::hessianPattern(std::vector<int>& rows, std::vector<int>& columns) const {
+  if ((hessian_ != HessianOption::SampleDifferences && hessian_ != HessianOption::ConvexSampleDifferences &&
+      hessian_ != HessianOption::GaussNewton && hessian_ != HessianOption::Exact))
+    return NlpProblem::hessianPattern(rows, columns);
+  // The motion's block (spline parameters and T) is declared dense; each sample's force
+  // columns meet only that sample's local parameters and its own force columns (what its slot's
+  // Bᵀ H B adds to below), and the duration when it is free. The motion's block has holes too
+  // (parameters whose splines share no sample), but telling Ipopt so moved two bundled bilevel
+  // optima by more than 1 % and saves little: its part of the factorisation is dense anyway
+  // (docs/developers/lab-notes/neighbours-and-stage-one.md, "The Hessian's sparsity").
+  const int curved = nonlinearVariableCount(), motion = forceStart_;
+  std::vector<char> meet(static_cast<std::size_t>(curved) * static_cast<std::size_t>(curved), 0);
+  auto mark = [&](int r, int c) { meet[static_cast<std::size_t>(std::max(r, c)) * static_cast<std::size_t>(curved) + static_cast<std::size_t>(std::min(r, c))] = 1; };
+  for (int r = 0; r < motion; ++r)
+    for (int c = 0; c <= r; ++c) mark(r, c);
+  for (const SampleBlock& b : blocks_)
+    for (const int f : b.forceColumns) {
+      for (const int p : b.parameters) mark(f, p);
+      for (const int g : b.forceColumns) mark(f, g);
+      if (durationIsFree()) mark(f, parameterCount_);
+    }
+  rows.clear(), columns.clear();
+  for (int r = 0; r < curved; ++r)
+    for (int c = 0; c <= r; ++c)
+      if (meet[static_cast<std::size_t>(r) * static_cast<std::size_t>(curved) + static_cast<std::size_t>(c)]) rows.push_back(r), columns.push_back(c);
+}
+
 void MotionProblem::sampleDifferencesHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                              const Eigen::Ref<const Eigen::VectorXd>& multipliers,
                                              Eigen::VectorXd& values) {

@@ -15,6 +15,13 @@ void NlpProblem::lagrangianGradient(const Eigen::VectorXd& x, double objectiveFa
   for (Eigen::Index k = 0; k < jacobianScratch_.size(); ++k) gradient[columns[k]] += jacobianScratch_[k] * multipliers[rows[k]];
 }
 
+void NlpProblem::hessianPattern(std::vector<int>& rows, std::vector<int>& columns) const {
+  const int curved = nonlinearVariableCount();
+  rows.clear(), columns.clear();
+  for (int r = 0; r < curved; ++r)
+    for (int c = 0; c <= r; ++c) rows.push_back(r), columns.push_back(c);
+}
+
 void NlpProblem::lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                    const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) {
   // Column c = (∇L(x + h e_c) − ∇L(x)) / h, then symmetrised. Forward differences: half the

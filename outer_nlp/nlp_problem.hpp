@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace mcopt {
 
@@ -42,6 +43,11 @@ class NlpProblem {
   /// nonlinear variable; a problem that knows its structure overrides it.
   virtual void lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                                  const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values);
+  /// The entries of lagrangianHessian's lower triangle that can be nonzero at any x and
+  /// multipliers, as (row, column) pairs, column ≤ row, row by row: the sparsity the solver is
+  /// told (its factorisation then skips the rest). Every entry of the dense triangle unless the
+  /// problem knows which variables never meet in one term.
+  virtual void hessianPattern(std::vector<int>& rows, std::vector<int>& columns) const;
   /// ∇L = σ ∇f + Jᵀ λ (all variables).
   void lagrangianGradient(const Eigen::VectorXd& x, double objectiveFactor,
                           const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& gradient);

@@ -282,6 +282,64 @@ TEST_CASE("sample-differences Hessian: every contact-force formulation", "[outer
   }
 }
 
+TEST_CASE("Hessian pattern: the entries it leaves out are zero in the Hessian and in the differences of the exact gradient",
+          "[outer][hessian][multi-contact]") {
+  // What Ipopt is told may be nonzero (MotionProblem::hessianPattern): the motion's block
+  // dense, each sample's force columns against its own parameters and force columns, the
+  // duration's row. Left out must mean zero: in the assembled Hessian, and in the Lagrangian's
+  // curvature itself (central differences of the exact gradient), for every formulation and
+  // assembled option, at a fixed and a free duration.
+  struct Case {
+    std::string forces;
+    HessianOption hessian;
+    bool freeDuration;
+  };
+  const std::vector<Case> cases = {{"bilevel", HessianOption::SampleDifferences, false},
+                                   {"splines", HessianOption::SampleDifferences, false},
+                                   {"splines", HessianOption::GaussNewton, true},
+                                   {"variables", HessianOption::SampleDifferences, true},
+                                   {"variables", HessianOption::GaussNewton, false},
+                                   {"variables", HessianOption::FiniteDifferences, false}};
+  for (const Case& c : cases) {
+    Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_lean_reach.yaml");
+    s.samples = 6;
+    s.controlPoints = 8;
+    s.outputSamples = 12;
+    s.forceControlPoints = 6;
+    s.contactForces = c.forces;
+    s.solve.hessian = c.hessian;
+    if (c.freeDuration) s.duration.lower = 0.9 * s.duration.initial, s.duration.upper = 1.2 * s.duration.initial;
+    MotionProblem problem(s);
+    const int curved = problem.nonlinearVariableCount();
+    std::vector<int> rows, columns;
+    problem.hessianPattern(rows, columns);
+    Eigen::MatrixXd declared = Eigen::MatrixXd::Zero(curved, curved);
+    for (std::size_t k = 0; k < rows.size(); ++k) declared(rows[k], columns[k]) = declared(columns[k], rows[k]) = 1.0;
+    const long triangle = static_cast<long>(curved) * (curved + 1) / 2;
+    INFO(c.forces << ", option " << static_cast<int>(c.hessian) << (c.freeDuration ? ", free duration" : "") << ": " << rows.size()
+                  << " of " << triangle << " entries declared");
+    const bool assembled = c.hessian != HessianOption::FiniteDifferences;
+    // Dense where there are no force variables or the option is the generic one; sparse otherwise.
+    CHECK((static_cast<long>(rows.size()) < triangle) == (assembled && problem.forceVariableCount() > 0));
+
+    Eigen::VectorXd x = test::perturbedMotion(problem, 0.02, 5);
+    const Eigen::VectorXd lambda = randomMultipliers(problem, 7);
+    Eigen::VectorXd values;
+    problem.lagrangianHessian(x, 1.0, lambda, values);
+    const Eigen::MatrixXd h = dense(values, curved);
+    const Eigen::MatrixXd differences = test::centralDifferences(x, 1e-5, [&] {
+      Eigen::VectorXd g;
+      problem.lagrangianGradient(x, 1.0, lambda, g);
+      return Eigen::VectorXd(g.head(curved));
+    });
+    const Eigen::MatrixXd reference = 0.5 * (differences.leftCols(curved) + differences.leftCols(curved).transpose());
+    const double scale = reference.cwiseAbs().maxCoeff();
+    const Eigen::ArrayXXd outside = 1.0 - declared.array();
+    CHECK((h.array() * outside).cwiseAbs().maxCoeff() == 0.0);
+    CHECK((reference.array() * outside).cwiseAbs().maxCoeff() <= 1e-12 * scale);
+  }
+}
+
 }  // namespace mcopt
 
 namespace mcopt {
