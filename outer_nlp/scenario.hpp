@@ -109,7 +109,7 @@ struct Scenario {
   std::string contactForces = "bilevel";
   int forceControlPoints = 9;      ///< per wrench spline (splines formulation), over its contact's window
   /// `force_units`: the unit in which Ipopt sees the splines and variables formulations' force variables.
-  ForceUnits forceUnits = ForceUnits::Newton;
+  ForceUnits forceUnits = ForceUnits::Weight;
   MultiContactSettings inner;      ///< bilevel: contact model and inner solver
   SensitivitySettings sensitivity; ///< bilevel: KKT backend
   bool contactConstraints = true;  ///< unilaterality, friction cone and CoP of W0 at the samples

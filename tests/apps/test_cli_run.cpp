@@ -1293,7 +1293,7 @@ TEST_CASE("run: multi-contact results, torques reproduced from states and contac
   CHECK_THAT(r.errors, Contains(bad.string() + ": contacts[0].wrenches[0]"));
 }
 
-TEST_CASE("run: --force-units hands Ipopt the force variables in weights, recorded, and leaves the bilevel problem alone",
+TEST_CASE("run: --force-units hands Ipopt the force variables in newtons or weights (the default), recorded, and leaves the bilevel problem alone",
           "[cli][run][multi-contact]") {
   const test::TempDir dir;
   const auto scenario = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
@@ -1310,18 +1310,18 @@ TEST_CASE("run: --force-units hands Ipopt the force variables in weights, record
     INFO(r.all());
     REQUIRE(r.exitCode == 4);
     const Json result = readJson(out / "result.json");
-    CHECK(result["force_units"] == (units.empty() ? "newton" : units));
+    CHECK(result["force_units"] == (units.empty() ? "weight" : units));
     std::vector<double> objective;
     for (const Json& h : result["history"]) objective.push_back(h["objective"].get<double>());
     return objective;
   };
-  const std::vector<double> newtons = run("variables", ""), weights = run("variables", "weight");
+  const std::vector<double> newtons = run("variables", "newton"), weights = run("variables", "weight");
   REQUIRE(newtons.size() == 4);
   REQUIRE(weights.size() == 4);
   CHECK(weights[0] == Approx(newtons[0]).epsilon(1e-12));  // x / m g · m g: the start to rounding
   CHECK(weights.back() != newtons.back());
-  CHECK(run("variables", "newton") == newtons);
-  CHECK(run("bilevel", "weight") == run("bilevel", ""));  // no force variables: the same iterates, to the bit
+  CHECK(run("variables", "") == weights);  // the default
+  CHECK(run("bilevel", "newton") == run("bilevel", ""));  // no force variables: the same iterates, to the bit
 }
 
 TEST_CASE("run: --inner-solver overrides the scenario's inner.solver", "[cli][run][multi-contact]") {

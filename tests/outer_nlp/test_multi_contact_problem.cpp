@@ -135,7 +135,7 @@ TEST_CASE("multi-contact outer problem: force_units is read from the file, and a
           "[outer][multi-contact]") {
   const test::TempDir dir;
   const auto source = test::sourceDir() / "scenarios/hrp2_weight_shift.yaml";
-  CHECK(loadScenario(source).forceUnits == ForceUnits::Newton);
+  CHECK(loadScenario(source).forceUnits == ForceUnits::Weight);  // the default
   const auto weight = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "weight"; }, "weight.yaml");
   CHECK(loadScenario(weight).forceUnits == ForceUnits::Weight);
   const auto newton = test::scenarioVariant(source, dir, [](YAML::Node& root) { root["force_units"] = "newton"; }, "newton.yaml");
