@@ -38,8 +38,8 @@ void MotionProblem::lagrangianHessian(const Eigen::VectorXd& x, double objective
 }
 
 void MotionProblem::hessianPattern(std::vector<int>& rows, std::vector<int>& columns) const {
-  if ((hessian_ != HessianOption::SampleDifferences && hessian_ != HessianOption::ConvexSampleDifferences &&
-      hessian_ != HessianOption::GaussNewton && hessian_ != HessianOption::Exact))
+  if (hessian_ != HessianOption::SampleDifferences && hessian_ != HessianOption::ConvexSampleDifferences &&
+      hessian_ != HessianOption::GaussNewton && hessian_ != HessianOption::Exact)
     return NlpProblem::hessianPattern(rows, columns);
   // The motion's block (spline parameters and T) is declared dense; each sample's force
   // columns meet only that sample's local parameters and its own force columns (what its slot's

@@ -283,9 +283,9 @@ class MotionProblem final : public NlpProblem {
   /// the generic differences of whole gradients (NlpProblem).
   void lagrangianHessian(const Eigen::VectorXd& x, double objectiveFactor,
                          const Eigen::Ref<const Eigen::VectorXd>& multipliers, Eigen::VectorXd& values) override;
-  /// The assembled options' pattern: the pairs of variables that share a sample or a task
-  /// instant (its local spline parameters and force columns), and the duration's row when it
-  /// is free; the generic differences keep the dense triangle.
+  /// The assembled options' pattern: the motion's block (spline parameters, a free duration)
+  /// dense, and each force variable against the local parameters and force columns of the
+  /// samples it enters and a free duration; the generic differences keep the dense triangle.
   void hessianPattern(std::vector<int>& rows, std::vector<int>& columns) const override;
 
   /// Largest violation of constraint rows and variable bounds, overall and per kind
