@@ -316,7 +316,7 @@ TEST_CASE("Hessian pattern: the entries it leaves out are zero in the Hessian an
     Eigen::MatrixXd declared = Eigen::MatrixXd::Zero(curved, curved);
     for (std::size_t k = 0; k < rows.size(); ++k) declared(rows[k], columns[k]) = declared(columns[k], rows[k]) = 1.0;
     const long triangle = static_cast<long>(curved) * (curved + 1) / 2;
-    INFO(c.forces << ", option " << static_cast<int>(c.hessian) << (c.freeDuration ? ", free duration" : "") << ": " << rows.size()
+    INFO(c.forces << ", " << toString(c.hessian) << (c.freeDuration ? ", free duration" : "") << ": " << rows.size()
                   << " of " << triangle << " entries declared");
     const bool assembled = c.hessian != HessianOption::FiniteDifferences;
     // Dense where there are no force variables or the option is the generic one; sparse otherwise.
