@@ -3,6 +3,7 @@
 
 #include "apps/result_motion.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -50,6 +51,14 @@ nlohmann::ordered_json energyBalanceJson(const EnergyBalance& b) {
   j["instants"] = b.instants;
   j["instants_per_interval"] = b.instantsPerInterval;
   j["wrenches_between_samples"] = b.wrenchesBetweenSamples;
+  if (b.redistribution.applies) {
+    const WrenchRedistribution& r = b.redistribution;
+    j["wrenches_redistributed"] = {{"instants", r.instants},
+                                   {"unreachable", r.unreachable},
+                                   {"largest_change", r.largestChange},
+                                   {"time", std::isnan(r.time) ? Json(nullptr) : Json(r.time)},
+                                   {"contact", r.contact}};
+  }
   j["joint_work_J"] = b.jointWork;
   j["joint_power_flow_J"] = b.jointPowerFlow;
   j["contact_work_J"] = b.contactWork;

@@ -72,6 +72,14 @@ int runVerify(const VerifyOptions& o) {
   std::cout << "\n  energy " << std::setprecision(6) << v.sampledEnergy << " J at the samples, " << v.fineEnergy
             << " J on the fine grid; mechanical identity residual " << std::setprecision(3) << v.balance.mechanicalResidual()
             << " J of " << v.balance.mechanicalScale() << " J\n";
+  if (const WrenchRedistribution& moved = v.balance.redistribution; moved.applies && (moved.instants > 0 || moved.unreachable > 0)) {
+    std::cout << "  wrenches redistributed between samples at " << moved.instants << " of " << v.instants
+              << " instants: the closest admissible with the same total wrench";
+    if (moved.instants > 0)
+      std::cout << ", largest change " << number(moved.largestChange) << " (" << moved.contact << ", " << number(moved.time) << " s)";
+    if (moved.unreachable > 0) std::cout << "; " << moved.unreachable << " instants with no admissible distribution";
+    std::cout << "\n";
+  }
   if (v.innerProblems > 0)
     std::cout << "  inner problems: " << v.innerProblems << " solved, " << v.innerInfeasible << " infeasible, " << v.innerFailed << " failed\n";
   std::cout << "  written " << out.string() << " (" << std::setprecision(2) << r.seconds << " s)\n";

@@ -71,11 +71,10 @@ int energyGridInstants(const Scenario& scenario, int atLeast) {
 
 EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, int instantsPerInterval) {
   if (instantsPerInterval == 0) instantsPerInterval = energyGridInstants(problem.scenario(), 10);
-  const Scenario fineScenario = fineGridScenario(problem.scenario(), instantsPerInterval);
-  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
-  const SampledPhysics physics = fine.sampledPhysics(fine.pointWithWrenchesFrom(problem, x), MotionProblem::ClosureDrift::Skipped);
-  EnergyBalance b = energyBalanceOf(fine, physics);
+  FineGridMotion fine(problem, x, instantsPerInterval, scenarioConstraintTolerance(problem.scenario()));
+  EnergyBalance b = energyBalanceOf(fine.problem(), fine.physics());
   b.instantsPerInterval = instantsPerInterval;
+  b.redistribution = fine.redistribution();
   return b;
 }
 

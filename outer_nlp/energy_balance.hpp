@@ -18,11 +18,14 @@
 // among them). Between the samples the wrenches are the formulation's own where it defines
 // them — the reference contact alone (the balance), the inner problem at each instant (bilevel),
 // the wrench splines (splines) — and, for the `variables` formulation, which defines them at the
-// samples only, interpolated linearly in time between them (`wrenchesBetweenSamples` says which).
+// samples only, interpolated linearly in time between them (`wrenchesBetweenSamples` says which);
+// for `splines` and `variables`, the closest admissible distribution of the same total wrench
+// wherever theirs breaks a contact row (fine_grid_motion.hpp, `redistribution`).
 
 #include <Eigen/Core>
 #include <string>
 
+#include "outer_nlp/fine_grid_motion.hpp"
 #include "outer_nlp/motion_problem.hpp"
 
 namespace mcopt {
@@ -31,6 +34,9 @@ struct EnergyBalance {
   int instants = 0;                 ///< of the fine grid
   int instantsPerInterval = 0;
   std::string wrenchesBetweenSamples;  ///< "balance", "inner problem", "splines" or "linear interpolation"
+  /// `splines`, `variables`: where the fine grid took the closest admissible wrenches instead of
+  /// the formulation's between the samples (fine_grid_motion.hpp).
+  WrenchRedistribution redistribution;
 
   double jointWork = 0.0;           ///< ∫ Σ Γ q̇ dt [J]
   double contactWork = 0.0;         ///< ∫ Σ_i F_i·V_i dt: the environment contacts' work on the robot [J]

@@ -196,6 +196,14 @@ Eigen::VectorXd MotionProblem::pointWithWrenchesFrom(MotionProblem& other, const
   return y;
 }
 
+Eigen::VectorXd MotionProblem::pointWithWrenches(const Eigen::VectorXd& motionParameters, double T,
+                                                 const std::vector<Eigen::MatrixXd>& wrenches) {
+  if (forceVariableCount() == 0) throw std::invalid_argument("pointWithWrenches: the formulation has no force variables");
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(forceVariableCount());
+  formulation_->fit(wrenches, z);
+  return pointFromMotion(motionParameters, T, z);
+}
+
 Eigen::VectorXd MotionProblem::reportedMotionParameters(const Eigen::VectorXd& x) {
   Eigen::VectorXd parameters = motionParameters(x);
   if (!closure_) return parameters;

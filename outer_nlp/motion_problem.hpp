@@ -265,6 +265,10 @@ class MotionProblem final : public NlpProblem {
   /// `variables` formulation's wrenches, defined at other's samples only, interpolated linearly
   /// in time (within the ball's carried and released parts apart); slacks at max(P, 0).
   Eigen::VectorXd pointWithWrenchesFrom(MotionProblem& other, const Eigen::VectorXd& x);
+  /// The motion (spline parameters, duration T) with its force variables fitted to given
+  /// environment-contact wrenches (6 × samples each, in the contact's frame; formulation's fit),
+  /// slacks at max(P, 0). Throws std::invalid_argument without force variables.
+  Eigen::VectorXd pointWithWrenches(const Eigen::VectorXd& motionParameters, double T, const std::vector<Eigen::MatrixXd>& wrenches);
   Eigen::VectorXd motionParameters(const Eigen::VectorXd& x) const { return x.head(parameterCount_); }
   /// x's spline parameters, with each closing joint's (unused: closed_chains.hpp) replaced by a
   /// least-squares fit of its motion at the samples — what a result reports, so that its
@@ -305,6 +309,8 @@ class MotionProblem final : public NlpProblem {
   /// The NLP's samples: the scenario's N, and with a ball the release sample twice (loaded,
   /// then released). Normalised times and trapezoid weights (fractions of T).
   int sampleCount() const { return samples_.sampleCount(); }
+  /// Sample s's instant [s] in a motion of duration T.
+  double sampleTime(int s, double T) const { return sampleTimes_[static_cast<std::size_t>(s)] * T; }
   /// Sample s's trapezoid weight, a fraction of T: (u_{s+1} − u_{s−1}) / 2.
   double sampleWeight(int s) const { return sampleWeights_[static_cast<std::size_t>(s)]; }
   bool sampleCarriesBall(int s) const { return loaded_[static_cast<std::size_t>(s)]; }

@@ -66,12 +66,6 @@ std::vector<std::string> MotionVerification::failures() const {
   return names;
 }
 
-double scenarioConstraintTolerance(const Scenario& scenario) {
-  for (const SolverOption& o : scenario.solve.solverOptions)
-    if (o.name == "constr_viol_tol") return o.type == SolverOption::Type::Integer ? o.integer : o.number;
-  return 1e-4;  // Ipopt's default
-}
-
 MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x, const VerificationSettings& settings) {
   if (settings.instantsPerInterval < 1) throw std::invalid_argument("verifyMotion: instantsPerInterval must be at least 1");
   const Scenario& scenario = problem.scenario();
@@ -86,10 +80,10 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   v.sampledEnergy = sampled.energy;
   std::vector<double> sampleTimes(sampled.time.data(), sampled.time.data() + sampled.time.size());
 
-  const Scenario fineScenario = fineGridScenario(scenario, settings.instantsPerInterval);
-  MotionProblem fine(fineScenario, {.hessian = fineScenario.solve.hessian, .derivatives = false});  // values only
-  const Eigen::VectorXd xf = fine.pointWithWrenchesFrom(problem, x);
-  const SampledPhysics physics = fine.sampledPhysics(xf, MotionProblem::ClosureDrift::Skipped);
+  FineGridMotion fineGrid(problem, x, settings.instantsPerInterval, tol);
+  MotionProblem& fine = fineGrid.problem();
+  const Eigen::VectorXd& xf = fineGrid.point();
+  const SampledPhysics& physics = fineGrid.physics();
   v.instants = static_cast<int>(physics.time.size());
 
   // Every row of the problem on the fine grid, by kind (the epigraph's slacks are set at
@@ -192,6 +186,7 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   // mechanical energy identity on the fine grid.
   v.balance = energyBalanceOf(fine, physics);
   v.balance.instantsPerInterval = settings.instantsPerInterval;
+  v.balance.redistribution = fineGrid.redistribution();
   v.wrenchesBetweenSamples = v.balance.wrenchesBetweenSamples;
   v.fineEnergy = v.balance.positiveEnergy;
   CheckBuilder energy("energy_sampled_vs_fine", "relative", settings.energyTolerance);

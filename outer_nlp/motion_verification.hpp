@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "outer_nlp/energy_balance.hpp"
+#include "outer_nlp/fine_grid_motion.hpp"
 #include "outer_nlp/motion_problem.hpp"
 
 namespace mcopt {
@@ -68,10 +69,6 @@ struct MotionVerification {
   /// The failing checks' names, in order.
   std::vector<std::string> failures() const;
 };
-
-/// The constraint tolerance a scenario's run holds its rows to: its solver option
-/// constr_viol_tol, else Ipopt's default 1e-4.
-double scenarioConstraintTolerance(const Scenario& scenario);
 
 /// Verifies the motion of `problem` at x (see above). The problem is evaluated once at x (its
 /// sampled energy); the fine grid is a problem of its own.
