@@ -153,20 +153,17 @@ TEST_CASE("fine grid: a single-level formulation's wrenches broken between the s
 }
 
 TEST_CASE("fine grid: bilevel wrenches and a single contact are never redistributed", "[outer][verify]") {
-  Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_kick.yaml");
-  s.samples = 12, s.outputSamples = 20;
-  s.solve.continuation.clear();
-  MotionProblem kick(s);
-  const FineGridMotion one(kick, kick.initialPoint(s.start, s.end), 4, 1e-6);
-  CHECK_FALSE(one.redistribution().applies);
-  CHECK(one.redistribution().instants == 0);
-  Scenario w = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
-  w.samples = 8, w.outputSamples = 20;
-  w.solve.continuation.clear();
-  MotionProblem shift(w);
-  const FineGridMotion two(shift, shift.initialPoint(w.start, w.end), 4, 1e-6);
-  CHECK_FALSE(two.redistribution().applies);
-  CHECK(two.redistribution().instants == 0);
+  // The kick (the reference sole alone) and the bilevel weight shift (an inner problem at each instant).
+  for (const char* file : {"scenarios/hrp2_kick.yaml", "scenarios/hrp2_weight_shift.yaml"}) {
+    Scenario s = loadScenario(test::sourceDir() / file);
+    s.samples = 8, s.outputSamples = 20;
+    s.solve.continuation.clear();
+    MotionProblem problem(s);
+    const FineGridMotion fine(problem, problem.initialPoint(s.start, s.end), 4, 1e-6);
+    INFO(file);
+    CHECK_FALSE(fine.redistribution().applies);
+    CHECK(fine.redistribution().instants == 0);
+  }
 }
 
 }  // namespace mcopt
