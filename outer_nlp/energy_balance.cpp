@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "core/dynamics_data.hpp"
 #include "core/inverse_dynamics.hpp"
@@ -25,25 +24,6 @@ struct InstantEnergy {
 };
 
 }  // namespace
-
-Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval) {
-  if (instantsPerInterval < 1) throw std::invalid_argument("fineGridScenario: instantsPerInterval must be at least 1");
-  Scenario fine = scenario;
-  fine.samples = instantsPerInterval * (scenario.samples - 1) + 1;
-  if (fine.ball) {
-    // The release where the scenario's grid has it (MotionProblem puts it on the nearest
-    // sample): on the fine grid, that sample's instant, not its own nearest to the time asked.
-    const int intervals = scenario.samples - 1;
-    const long release = std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals);
-    fine.ball->releaseTime = static_cast<double>(release) / intervals * scenario.duration.initial;
-    for (TaskSpec& task : fine.tasks)
-      if (task.task->reads() == TaskQuantity::Ball)
-        task.start = task.end = fine.ball->releaseTime;
-  }
-  fine.solve.torqueScreening = 0.0;
-  fine.solve.continuation.clear();
-  return fine;
-}
 
 int energyGridInstants(const Scenario& scenario, int atLeast) {
   const BSplineBasis basis(scenario.controlPoints);

@@ -80,10 +80,6 @@ EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, in
 /// each side).
 int energyGridInstants(const Scenario& scenario, int atLeast);
 
-/// The scenario on a grid of `instantsPerInterval` instants per interval of its samples, with no
-/// continuation and every torque-limit row (the problem energyBalance builds).
-Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval);
-
 /// The balance of given physics at the samples of `problem` (the fine grid's problem of
 /// energyBalance, whose sampledPhysics they are): apart so that a test can perturb them.
 EnergyBalance energyBalanceOf(const MotionProblem& problem, const SampledPhysics& physics);

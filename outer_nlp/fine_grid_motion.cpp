@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "core/dynamics_data.hpp"
 #include "core/inverse_dynamics.hpp"
@@ -12,7 +13,6 @@
 #include "inner_qp/dual_active_set_qp.hpp"
 #include "inner_qp/multi_contact_dynamics.hpp"
 #include "outer_nlp/contact_admissibility.hpp"
-#include "outer_nlp/energy_balance.hpp"
 #include "outer_nlp/formulation_registry.hpp"
 
 namespace mcopt {
@@ -46,6 +46,25 @@ Matrix6 wrenchToWorld(const RigidTransform& pose) {
 }
 
 }  // namespace
+
+Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval) {
+  if (instantsPerInterval < 1) throw std::invalid_argument("fineGridScenario: instantsPerInterval must be at least 1");
+  Scenario fine = scenario;
+  fine.samples = instantsPerInterval * (scenario.samples - 1) + 1;
+  if (fine.ball) {
+    // The release where the scenario's grid has it (MotionProblem puts it on the nearest
+    // sample): on the fine grid, that sample's instant, not its own nearest to the time asked.
+    const int intervals = scenario.samples - 1;
+    const long release = std::lround(scenario.ball->releaseTime / scenario.duration.initial * intervals);
+    fine.ball->releaseTime = static_cast<double>(release) / intervals * scenario.duration.initial;
+    for (TaskSpec& task : fine.tasks)
+      if (task.task->reads() == TaskQuantity::Ball)
+        task.start = task.end = fine.ball->releaseTime;
+  }
+  fine.solve.torqueScreening = 0.0;
+  fine.solve.continuation.clear();
+  return fine;
+}
 
 double scenarioConstraintTolerance(const Scenario& scenario) {
   for (const SolverOption& o : scenario.solve.solverOptions)

@@ -38,6 +38,10 @@ struct WrenchRedistribution {
   std::string contact;     ///< whose component
 };
 
+/// The scenario on a grid of `instantsPerInterval` instants per interval of its samples, with no
+/// continuation and every torque-limit row (FineGridMotion's).
+Scenario fineGridScenario(const Scenario& scenario, int instantsPerInterval);
+
 /// The constraint tolerance a scenario's run holds its rows to: its solver option
 /// constr_viol_tol, else Ipopt's default 1e-4.
 double scenarioConstraintTolerance(const Scenario& scenario);
