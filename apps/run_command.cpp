@@ -186,6 +186,7 @@ int runMotion(const RunOptions& o) {
       else
         std::cout << ", epigraph";
       std::cout << ", " << solve.scenario.samples << " samples";
+      if (solve.scenario.contactForces != scenario.contactForces) std::cout << ", contact forces " << solve.scenario.contactForces;
       if (solve.problem.bilevel())
         std::cout << ", inner solver " << solve.scenario.inner.solverName << ", " << toString(solve.scenario.inner.feasibility)
                   << " row";

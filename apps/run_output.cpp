@@ -276,6 +276,7 @@ RunFiles makeRunFiles(MotionProblem& problem, const RunRecord& record, bool with
                       {"smoothing", stage.energyForm == EnergyForm::Epigraph ? Json(nullptr) : Json(stage.smoothing)},
                       {"samples", stage.samples},
                       {"hessian", toString(stage.hessian)},
+                      {"contact_forces", stage.contactForces.empty() ? Json(nullptr) : Json(stage.contactForces)},
                       {"inner_solver", stage.innerSolver.empty() ? Json(nullptr) : Json(stage.innerSolver)},
                       {"feasibility", stage.feasibility.empty() ? Json(nullptr) : Json(stage.feasibility)},
                       {"status", toString(stage.status)},

@@ -48,6 +48,8 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
   int unfinished = -1;
   Eigen::VectorXd unfinishedStart;
   Eigen::MatrixXd unfinishedAngles;
+  // The formulation x and unfinishedStart are points of (a stage's contact_forces can differ).
+  std::string xForces = scenario.contactForces, unfinishedForces;
   for (int k = 0; k < stages; ++k) {
     const bool last = k + 1 == stages;
     const Scenario stageScenario = continuationStage(scenario, static_cast<std::size_t>(k));
@@ -64,14 +66,18 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     // variables set from it (MotionProblem::pointFrom; the smooth maximum's optimum, then the
     // exact epigraph form: docs/theory/outer-problem.md, "Continuation").
     full.startClosureAt(closureAngles);
-    if (x.size() != full.variableCount()) x = full.pointFrom(problem, x);
+    // Another formulation's point (a stage's contact_forces) hands on its motion, the force
+    // variables fitted to the inner problem's wrenches along it.
+    if (x.size() != full.variableCount() || xForces != stageScenario.contactForces) x = full.pointFrom(problem, x);
+    xForces = stageScenario.contactForces;
     // A stage that ended worse than it began hands on its start instead, judged in this
     // stage's problem (each point on its own closure branch).
     int restartedFrom = -1;
     StagePoint handed, restart;
     if (unfinished >= 0) {
       Eigen::VectorXd start = unfinishedStart;
-      if (start.size() != full.variableCount()) start = full.pointFrom(problem, start);
+      if (start.size() != full.variableCount() || unfinishedForces != stageScenario.contactForces)
+        start = full.pointFrom(problem, start);
       handed = {full.violations(x).overall, full.objective(x)};
       full.startClosureAt(unfinishedAngles);
       restart = {full.violations(start).overall, full.objective(start)};
@@ -98,6 +104,7 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     stage.samples = stageScenario.samples;
     stage.hessian = stageScenario.solve.hessian;
     stage.energyForm = stageScenario.energyForm;
+    if (!stageScenario.contacts.empty()) stage.contactForces = stageScenario.contactForces;
     if (full.bilevel()) {
       stage.innerSolver = stageScenario.inner.solverName;
       stage.feasibility = toString(stageScenario.inner.feasibility);
@@ -195,11 +202,12 @@ MotionSolveOutcome solveMotion(const Scenario& given, MotionProblem& problem, co
     }
     if (usable && outcome.optimal()) solved = stageScenario;
     if (usable && !outcome.optimal() && outcome.status != OuterStatus::Stalled)
-      unfinished = k, unfinishedStart = stageStart, unfinishedAngles = stageStartAngles;
+      unfinished = k, unfinishedStart = stageStart, unfinishedAngles = stageStartAngles, unfinishedForces = xForces;
     if (last || outcome.status == OuterStatus::Interrupted || !usable) {
       result.solver = outcome;
       if (!last) {
-        result.solver.x = x;  // the last usable iterate, of an earlier stage
+        // The last usable iterate, of an earlier stage, as a point of the scenario's problem.
+        result.solver.x = x.size() != problem.variableCount() || xForces != scenario.contactForces ? problem.pointFrom(problem, x) : x;
         result.reason = "stopped in continuation stage " + std::to_string(k + 1) + " of " + std::to_string(stages) +
                         " (" + toString(outcome.status) + ")";
       }

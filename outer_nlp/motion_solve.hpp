@@ -24,6 +24,7 @@ struct StageOutcome {
   EnergyForm energyForm = EnergyForm::SmoothMaximum;
   std::string innerSolver;  ///< bilevel: the stage's inner solver; empty otherwise
   std::string feasibility;  ///< bilevel: the stage's inner-feasibility row (slack, margin); empty otherwise
+  std::string contactForces;  ///< with environment contacts: the formulation the stage ran in; empty otherwise
   OuterStatus status = OuterStatus::InternalError;  ///< of its last solve
   double objective = 0.0;                           ///< of its last solve
   int iterations = 0;                               ///< over its rounds

@@ -386,8 +386,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       if (!stage.IsMap()) throw InputError(where(file, stage, field) + "expected {friction_sharpness: ν, smoothing: ε}");
       yaml::rejectUnknownKeys(file, stage, field,
                               {"friction_sharpness", "smoothing", "samples", "hessian", "max_iterations", "energy",
-                               "for_contact_forces", "inner_solver", "feasibility"});
-      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}, {}, {}};
+                               "for_contact_forces", "contact_forces", "inner_solver", "feasibility"});
+      ContinuationStage c{s.actuators.frictionSharpness, s.smoothing, s.samples, s.solve.hessian, -1, s.energyForm, {}, {}, {}, {}};
       if (stage["energy"]) {
         const std::string form = yaml::text(file, stage["energy"], field + ".energy");
         if (form == "smooth_max") c.energyForm = EnergyForm::SmoothMaximum;
@@ -423,6 +423,18 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
           if (std::find(c.forContactForces.begin(), c.forContactForces.end(), forces) != c.forContactForces.end())
             throw InputError(where(file, only[i], item) + "'" + forces + "' is listed twice");
           c.forContactForces.push_back(forces);
+        }
+      }
+      if (const YAML::Node forces = stage["contact_forces"]) {
+        const std::string forcesField = field + ".contact_forces";
+        if (s.contacts.empty())
+          throw InputError(where(file, forces, forcesField) +
+                           "the scenario has no contact besides the reference body's, where every formulation is the same "
+                           "problem");
+        try {
+          c.contactForces = contactForceFormulation(yaml::text(file, forces, forcesField)).name;
+        } catch (const InputError& e) {
+          throw InputError(where(file, forces, forcesField) + e.what());
         }
       }
       if (const YAML::Node inner = stage["inner_solver"]) {

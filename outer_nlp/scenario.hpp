@@ -152,10 +152,10 @@ struct Scenario {
 Scenario withStagesForItsFormulation(const Scenario& scenario);
 /// Stage k of the scenario's continuation (k = solve.continuation.size(): the scenario itself):
 /// a copy with that stage's friction sharpness, smoothing, samples, Hessian option, energy form,
-/// inner solver and inner-feasibility row.
+/// inner solver, inner-feasibility row and contact-force formulation.
 Scenario continuationStage(const Scenario& scenario, std::size_t k);
 /// Whether a stage (continuationStage's copy) poses the scenario's own problem: the same ν, ε,
-/// samples, energy form and (where an inner problem picks the wrenches) inner solver and row,
+/// samples, energy form, contact-force formulation and (where an inner problem picks the wrenches) inner solver and row,
 /// differing at most in its Hessian option or iteration limit.
 bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario);
 /// Why `hessian: exact` does not apply to the scenario (empty when it does): its stencils need

@@ -59,7 +59,9 @@ void overrideHessian(Scenario& scenario, HessianOption hessian) {
     }
   scenario.solve.continuation = std::move(kept);
   if (hessian != HessianOption::Exact) return;
-  for (std::size_t k = 0; k <= scenario.solve.continuation.size(); ++k)
+  // The scenario's own problem first, then its stages (one solved in another formulation has
+  // reasons of its own).
+  for (std::size_t k = scenario.solve.continuation.size() + 1; k-- > 0;)
     if (const std::string why = exactHessianRefusal(continuationStage(scenario, k)); !why.empty())
       throw InputError("--hessian: exact: " + why);
 }

@@ -173,6 +173,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
     stage.energyForm = scenario.solve.continuation[k].energyForm;
     if (!scenario.solve.continuation[k].innerSolver.empty()) stage.inner.solverName = scenario.solve.continuation[k].innerSolver;
     if (scenario.solve.continuation[k].feasibility) stage.inner.feasibility = *scenario.solve.continuation[k].feasibility;
+    if (!scenario.solve.continuation[k].contactForces.empty()) stage.contactForces = scenario.solve.continuation[k].contactForces;
   }
   return stage;
 }
@@ -180,6 +181,7 @@ Scenario continuationStage(const Scenario& scenario, std::size_t k) {
 bool posesScenarioProblem(const Scenario& stage, const Scenario& scenario) {
   return stage.actuators.frictionSharpness == scenario.actuators.frictionSharpness && stage.smoothing == scenario.smoothing &&
          stage.samples == scenario.samples && stage.energyForm == scenario.energyForm &&
+         stage.contactForces == scenario.contactForces &&
          (stage.contacts.empty() || !contactForceFormulation(stage.contactForces).innerProblem ||
           (stage.inner.solverName == scenario.inner.solverName && stage.inner.feasibility == scenario.inner.feasibility));
 }

@@ -96,6 +96,14 @@ struct ContinuationStage {
   /// admissibility can end without a constraint qualification; the margin row has one there
   /// (docs/theory/outer-problem.md, "Inner feasibility").
   std::optional<InnerFeasibility> feasibility;
+  /// The contact-force formulation the stage itself is solved in (`contact_forces`); empty: the
+  /// run's. The next stage starts from its motion, with its own force variables fitted to the
+  /// inner problem's wrenches along it (MotionProblem::pointFrom), as `mcopt run --start-from`
+  /// does: a bilevel Gauss–Newton stage hands the single-level formulations a motion whose
+  /// wrenches are admissible at every sample (measured on the weight shift: `variables` then
+  /// optimal after 22 iterations at 61.73 J, against 333 at 65.77 J from the interpolated motion;
+  /// docs/developers/lab-notes/neighbours-and-stage-one.md).
+  std::string contactForces;
   /// Whether the stage runs with that formulation.
   bool runsWith(const std::string& forces) const {
     return forContactForces.empty() ||

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "common/json_file.hpp"
 #include "common/run_command.hpp"
@@ -936,6 +937,13 @@ TEST_CASE("run: every class of bad scenario is refused with file, line and field
       {"continuation stage formulations without a second contact", [](YAML::Node& r) {
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, for_contact_forces: [bilevel]}]");
        }, {"continuation[0].for_contact_forces: the scenario has no contact besides the reference body's"}},
+      {"continuation stage in an unknown formulation", [](YAML::Node& r) {
+         r["contacts"] = YAML::Load("[l_sole, r_sole]");
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, contact_forces: bilevl}]");
+       }, {"continuation[0].contact_forces: unknown contact-force formulation 'bilevl' (expected bilevel, splines or variables)"}},
+      {"continuation stage in a formulation without a second contact", [](YAML::Node& r) {
+         r["continuation"] = YAML::Load("[{hessian: gauss-newton, contact_forces: bilevel}]");
+       }, {"continuation[0].contact_forces: the scenario has no contact besides the reference body's"}},
       {"continuation stage's unknown inner solver", [](YAML::Node& r) {
          r["contacts"] = YAML::Load("[l_sole, r_sole]");
          r["continuation"] = YAML::Load("[{hessian: gauss-newton, inner_solver: qpoases}]");
@@ -1080,6 +1088,48 @@ TEST_CASE("run: a continuation stage for some formulations runs only with them",
     REQUIRE(stages.size() == hessians.size());
     for (std::size_t k = 0; k < hessians.size(); ++k) CHECK(stages[k]["hessian"] == hessians[k]);
     CHECK_THAT(r.output, Contains(hessians.size() == 1 ? "Hessian: sample-differences;" : "stage 1 of 2"));
+  }
+}
+
+TEST_CASE("run: a continuation stage in the bilevel formulation hands a single-level run its motion, the forces the inner problem's "
+          "along it",
+          "[cli][run][multi-contact]") {
+  // The bundled weight shift's layout on 12 samples: a Gauss–Newton stage solved bilevel, then
+  // the run's own formulation from its motion (the force variables fitted to the inner
+  // problem's exact optima at every sample), each stage a few iterations.
+  const test::TempDir dir;
+  const auto weightShift = scenarioVariant(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml", dir, [](YAML::Node& root) {
+    root["samples"] = 12;
+    root["solver"]["max_iter"] = 3;
+    root["continuation"] = YAML::Load("[{hessian: gauss-newton, max_iterations: 15, contact_forces: bilevel, inner_solver: active-set}]");
+  }, "weight_shift.yaml");
+  for (const char* forces : {"variables", "splines", "bilevel"}) {
+    const auto out = dir.path() / forces;
+    const auto r = test::runMcopt("run " + test::quoted(weightShift) + " --contact-forces " + forces + " --out " + test::quoted(out));
+    INFO(forces << ": " << r.all());
+    REQUIRE((r.exitCode == 0 || r.exitCode == 4));
+    const Json result = readJson(out / "result.json");
+    const Json stages = result["continuation"];
+    CHECK(result["contact_forces"] == forces);
+    if (std::string(forces) == "bilevel" && stages.size() == 1) continue;  // its stage poses its problem and ended optimal
+    REQUIRE(stages.size() == 2);
+    CHECK(stages[0]["contact_forces"] == "bilevel");
+    CHECK(stages[0]["inner_solver"] == "active-set");
+    CHECK(stages[1]["contact_forces"] == forces);
+    if (std::string(forces) == "bilevel") continue;
+    CHECK(stages[1]["inner_solver"].is_null());
+    CHECK_THAT(r.output, Contains("stage 1 of 2: ") && Contains(", contact forces bilevel"));
+    if (std::string(forces) != "variables") continue;
+    // The variables start where the bilevel stage ended: the same criterion, every row held
+    // (the inner optima are admissible at every sample). (The force splines start from a
+    // least-squares fit of those wrenches; here, worse than the stage's start, from that start.)
+    CHECK(stages[1]["restarted_from_stage"].is_null());
+    std::optional<Json> first;
+    for (const Json& h : result["history"])
+      if (h["stage"] == 1 && !first) first = h;
+    REQUIRE(first);
+    CHECK(first->at("objective").get<double>() == Approx(stages[0]["objective"].get<double>()).epsilon(1e-9));
+    CHECK(first->at("violation").get<double>() <= 1e-6);
   }
 }
 

@@ -136,6 +136,7 @@ TEST_CASE("continuation: a stage with another inner solver poses another problem
   s.inner.solverName = "barrier";
   ContinuationStage stage = s.solve.continuation.at(0);
   stage.innerSolver = "active-set";
+  stage.contactForces.clear();  // the run's formulation (the bundled stage's is bilevel's)
   s.solve.continuation = {stage};
   const Scenario first = continuationStage(s, 0), own = continuationStage(s, 1);
   CHECK(first.inner.solverName == "active-set");
@@ -149,6 +150,11 @@ TEST_CASE("continuation: a stage with another inner solver poses another problem
   s.solve.continuation[0].innerSolver = "active-set";
   s.contactForces = "variables";
   CHECK(posesScenarioProblem(continuationStage(s, 0), s));
+  // A stage solved in another formulation poses another problem (the bundled stage: bilevel).
+  s.solve.continuation[0].contactForces = "bilevel";
+  CHECK(continuationStage(s, 0).contactForces == "bilevel");
+  CHECK(continuationStage(s, 1).contactForces == "variables");
+  CHECK_FALSE(posesScenarioProblem(continuationStage(s, 0), s));
 }
 
 TEST_CASE("continuation: a stage with another feasibility row poses another problem, only where an inner problem picks the wrenches",
@@ -156,6 +162,7 @@ TEST_CASE("continuation: a stage with another feasibility row poses another prob
   Scenario s = loadScenario(test::sourceDir() / "scenarios/hrp2_weight_shift.yaml");
   s.inner.feasibility = InnerFeasibility::Margin;
   s.solve.continuation.at(0).innerSolver.clear();  // the stage differs in its Hessian and its row only
+  s.solve.continuation.at(0).contactForces.clear();
   s.solve.continuation.at(0).feasibility = InnerFeasibility::Slack;
   const Scenario first = continuationStage(s, 0), own = continuationStage(s, s.solve.continuation.size());
   CHECK(first.inner.feasibility == InnerFeasibility::Slack);
