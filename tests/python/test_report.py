@@ -53,13 +53,13 @@ def test_report_json_has_the_machine_every_figure_and_every_run(quick):
     assert set(runs) == expected
     for label, run in runs.items():
         # --max-iterations 1 bounds each continuation stage (the bundled scenarios have two: a
-        # Gauss–Newton stage, then sample-differences; the weight shift's first is for the
-        # bilevel formulation alone; the kick's are the smooth maximum's Gauss–Newton stage, then
+        # Gauss–Newton stage, then sample-differences; the weight shift's first is solved bilevel
+        # whatever the formulation; the kick's are the smooth maximum's Gauss–Newton stage, then
         # its epigraph form with sample differences; the throw has a margin-row stage between).
         assert run["status"] == "maximum_iterations" and run["iterations"] == run["stages"], label
         # The free-ends kick keeps the three stages the bundled kick had: the smooth maximum's
         # Gauss–Newton and sample-differences stages, then the epigraph form.
-        stages = 1 if label in ("weight_shift/splines", "weight_shift/variables") else 3 if label.startswith("kick-free-ends/") or label == "throw" else 2
+        stages = 3 if label.startswith("kick-free-ends/") or label == "throw" else 2
         assert run["stages"] == stages, label
         assert run["seconds"] > 0 and run["energy_J"] > 0 and run["max_violation"] >= 0, label
     # The runs are what their arguments say.
