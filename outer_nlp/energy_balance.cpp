@@ -54,18 +54,20 @@ EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, in
   FineGridMotion fine(problem, x, instantsPerInterval, scenarioConstraintTolerance(problem.scenario()));
   EnergyBalance b = energyBalanceOf(fine.problem(), fine.physics());
   b.instantsPerInterval = instantsPerInterval;
+  b.wrenchesBetweenSamples = wrenchesBetweenSamples(problem.scenario());  // a redistributed grid's carrier is `variables`
   b.redistribution = fine.redistribution();
   return b;
+}
+
+std::string wrenchesBetweenSamples(const Scenario& scenario) {
+  return scenario.contacts.empty() ? "balance" : contactForceFormulation(scenario.contactForces).betweenSamples;
 }
 
 EnergyBalance energyBalanceOf(const MotionProblem& fine, const SampledPhysics& p) {
   const Scenario& scenario = fine.scenario();
   EnergyBalance b;
   b.instants = static_cast<int>(p.time.size());
-  if (scenario.contacts.empty())
-    b.wrenchesBetweenSamples = "balance";
-  else
-    b.wrenchesBetweenSamples = contactForceFormulation(scenario.contactForces).betweenSamples;
+  b.wrenchesBetweenSamples = wrenchesBetweenSamples(scenario);
 
   const DynamicsModel& model = fine.model();  // the robot without the ball
   DynamicsData data(model);

@@ -80,6 +80,11 @@ EnergyBalance energyBalance(MotionProblem& problem, const Eigen::VectorXd& x, in
 /// each side).
 int energyGridInstants(const Scenario& scenario, int atLeast);
 
+/// How a scenario's contact wrenches are known between its samples: "balance" (the reference
+/// contact alone), else its formulation's (registry: "inner problem", "splines", "linear
+/// interpolation") — the scenario's own, whichever problem carries its fine grid.
+std::string wrenchesBetweenSamples(const Scenario& scenario);
+
 /// The balance of given physics at the samples of `problem` (the fine grid's problem of
 /// energyBalance, whose sampledPhysics they are): apart so that a test can perturb them.
 EnergyBalance energyBalanceOf(const MotionProblem& problem, const SampledPhysics& physics);

@@ -186,6 +186,7 @@ MotionVerification verifyMotion(MotionProblem& problem, const Eigen::VectorXd& x
   // mechanical energy identity on the fine grid.
   v.balance = energyBalanceOf(fine, physics);
   v.balance.instantsPerInterval = settings.instantsPerInterval;
+  v.balance.wrenchesBetweenSamples = wrenchesBetweenSamples(scenario);  // a redistributed grid's carrier is `variables`
   v.balance.redistribution = fineGrid.redistribution();
   v.wrenchesBetweenSamples = v.balance.wrenchesBetweenSamples;
   v.fineEnergy = v.balance.positiveEnergy;

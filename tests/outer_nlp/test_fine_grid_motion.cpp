@@ -15,6 +15,7 @@
 #include "outer_nlp/energy_balance.hpp"
 #include "outer_nlp/fine_grid_motion.hpp"
 #include "outer_nlp/motion_problem.hpp"
+#include "outer_nlp/motion_verification.hpp"
 
 namespace mcopt {
 
@@ -148,7 +149,11 @@ TEST_CASE("fine grid: a single-level formulation's wrenches broken between the s
     CHECK(b.jointWork == Approx(own.jointWork).epsilon(1e-9).margin(1e-9));
     CHECK(b.mechanicalResidual() == Approx(own.mechanicalResidual()).epsilon(1e-9).margin(1e-9));
     CHECK(b.positiveEnergy != own.positiveEnergy);  // the motors' torques, and their losses, are the new split's
-    CHECK(energyBalance(problem, *x, kInstants).redistribution.instants == moved.instants);
+    const EnergyBalance balance = energyBalance(problem, *x, kInstants);
+    CHECK(balance.redistribution.instants == moved.instants);
+    // The formulation's own account of its wrenches, not the carrier's.
+    CHECK(balance.wrenchesBetweenSamples == (forces == "splines" ? "splines" : "linear interpolation"));
+    CHECK(verifyMotion(problem, *x, {.instantsPerInterval = kInstants}).wrenchesBetweenSamples == balance.wrenchesBetweenSamples);
   }
 }
 
