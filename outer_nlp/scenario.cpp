@@ -159,6 +159,19 @@ Scenario loadScenario(const YAML::Node& root, const std::filesystem::path& file,
 
 namespace {
 
+/// A registered contact-force formulation's name at `node` (`field`), or an InputError there.
+std::string readFormulation(const std::filesystem::path& file, const YAML::Node& node, const std::string& field) {
+  try {
+    return contactForceFormulation(yaml::text(file, node, field)).name;
+  } catch (const InputError& e) {
+    throw InputError(where(file, node, field) + e.what());
+  }
+}
+
+/// Why a stage's formulation field means nothing with the reference contact alone (§9).
+constexpr const char* kOneFormulation =
+    "the scenario has no contact besides the reference body's, where every formulation is the same problem";
+
 Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
                       std::optional<std::string> contactForces, bool allowNonPhysicalInertia) {
   if (!root.IsMap()) throw InputError(file.string() + ":1: expected a mapping of scenario fields");
@@ -338,14 +351,7 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
   if (s.closureReachMargin > 0.0 && s.contacts.empty())
     throw InputError(where(file, root["closure_reach_margin"], "closure_reach_margin") +
                      "the scenario holds no contact besides the reference body's: there is no loop to keep from full stretch");
-  if (root["contact_forces"]) {
-    const YAML::Node node = root["contact_forces"];
-    try {
-      s.contactForces = contactForceFormulation(yaml::text(file, node, "contact_forces")).name;
-    } catch (const InputError& e) {
-      throw InputError(where(file, node, "contact_forces") + e.what());
-    }
-  }
+  if (root["contact_forces"]) s.contactForces = readFormulation(file, root["contact_forces"], "contact_forces");
   if (contactForces) s.contactForces = contactForceFormulation(*contactForces).name;
   if (root["force_control_points"])
     s.forceControlPoints = yaml::integerAtLeast(file, root["force_control_points"], "force_control_points", 4);
@@ -405,21 +411,13 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
         const std::string onlyField = field + ".for_contact_forces";
         // With the reference contact alone the three formulations are one problem (§9), and
         // whether such a stage ran would hang on a default that means nothing.
-        if (s.contacts.empty())
-          throw InputError(where(file, only, onlyField) +
-                           "the scenario has no contact besides the reference body's, where every formulation is the same "
-                           "problem");
+        if (s.contacts.empty()) throw InputError(where(file, only, onlyField) + kOneFormulation);
         if (!only.IsSequence() || only.size() == 0)
           throw InputError(where(file, only, onlyField) + "expected a non-empty list of formulations (" +
                            alternatives(contactForcesNames()) + ")");
         for (std::size_t i = 0; i < only.size(); ++i) {
           const std::string item = onlyField + "[" + std::to_string(i) + "]";
-          std::string forces;
-          try {
-            forces = contactForceFormulation(yaml::text(file, only[i], item)).name;
-          } catch (const InputError& e) {
-            throw InputError(where(file, only[i], item) + e.what());
-          }
+          const std::string forces = readFormulation(file, only[i], item);
           if (std::find(c.forContactForces.begin(), c.forContactForces.end(), forces) != c.forContactForces.end())
             throw InputError(where(file, only[i], item) + "'" + forces + "' is listed twice");
           c.forContactForces.push_back(forces);
@@ -427,15 +425,8 @@ Scenario readScenario(const YAML::Node& root, const std::filesystem::path& file,
       }
       if (const YAML::Node forces = stage["contact_forces"]) {
         const std::string forcesField = field + ".contact_forces";
-        if (s.contacts.empty())
-          throw InputError(where(file, forces, forcesField) +
-                           "the scenario has no contact besides the reference body's, where every formulation is the same "
-                           "problem");
-        try {
-          c.contactForces = contactForceFormulation(yaml::text(file, forces, forcesField)).name;
-        } catch (const InputError& e) {
-          throw InputError(where(file, forces, forcesField) + e.what());
-        }
+        if (s.contacts.empty()) throw InputError(where(file, forces, forcesField) + kOneFormulation);
+        c.contactForces = readFormulation(file, forces, forcesField);
       }
       if (const YAML::Node inner = stage["inner_solver"]) {
         const std::string innerField = field + ".inner_solver";
